@@ -1,0 +1,45 @@
+//! One error type for the whole library, so bindings can turn any failure into one readable message.
+
+use std::fmt;
+
+/// Everything that can go wrong before or while meshing. Messages are written for the person who
+/// passed the input: they name the offending sample, option or value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// A sample was NaN or infinite; meshing it would silently produce garbage.
+    NonFiniteSample { index: [usize; 3], position: [f32; 3], value: f32 },
+    /// The grid has no cells, mismatched buffer sizes, or bad bounds.
+    InvalidGrid(String),
+    /// The grid is larger than the configured cap (protects browsers from freezing or running out of memory).
+    GridTooLarge { cells: u64, max_cells: u64 },
+    /// An option had a value outside its meaningful range.
+    InvalidOption(String),
+    /// An unknown scene, method or other name.
+    UnknownName { kind: &'static str, name: String, known: Vec<String> },
+    /// Reading or writing a file failed.
+    Io(String),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NonFiniteSample { index, position, value } => write!(
+                f,
+                "sample ({}, {}, {}) at position ({}, {}, {}) is {}; every sample must be finite",
+                index[0], index[1], index[2], position[0], position[1], position[2], value
+            ),
+            Error::InvalidGrid(msg) => write!(f, "invalid grid: {msg}"),
+            Error::GridTooLarge { cells, max_cells } => write!(
+                f,
+                "grid of {cells} cells is larger than the limit of {max_cells} cells; lower the resolution or raise maxCells"
+            ),
+            Error::InvalidOption(msg) => write!(f, "invalid option: {msg}"),
+            Error::UnknownName { kind, name, known } => {
+                write!(f, "unknown {kind} '{name}'; known: {}", known.join(", "))
+            }
+            Error::Io(msg) => write!(f, "{msg}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}

@@ -1,0 +1,147 @@
+//! The sampling lattice: the single place that maps grid indices to world coordinates.
+
+use crate::error::Error;
+use glam::Vec3;
+
+/// Default cap on the number of cells, chosen so that one f32 per sample plus MC's edge caches stay
+/// well inside a browser tab's memory (about 300 MB of samples at the cap).
+pub const DEFAULT_MAX_CELLS: u64 = 72_000_000;
+
+/// A regular lattice of sample points: `cells[a] + 1` points along axis `a`, the first at `origin`,
+/// spaced by `spacing` (anisotropic spacing is allowed because CT and MRI stacks have it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    pub origin: Vec3,
+    pub spacing: Vec3,
+    pub cells: [usize; 3],
+}
+
+impl Grid {
+    /// A grid over `[min, max]` with `cells` cells per axis (spacing may differ per axis).
+    pub fn new(min: Vec3, max: Vec3, cells: [usize; 3]) -> Result<Grid, Error> {
+        check_bounds(min, max)?;
+        if cells.contains(&0) {
+            return Err(Error::InvalidGrid(format!(
+                "every axis needs at least one cell, got {} x {} x {}",
+                cells[0], cells[1], cells[2]
+            )));
+        }
+        let extent = max - min;
+        let spacing = Vec3::new(
+            extent.x / cells[0] as f32,
+            extent.y / cells[1] as f32,
+            extent.z / cells[2] as f32,
+        );
+        Ok(Grid { origin: min, spacing, cells })
+    }
+
+    /// A grid with cubic cells, `res` of them along the longest side of the bounds. The other axes get
+    /// as many cells as cover their extent, and the bounds grow (about their centre) to whole cells.
+    pub fn with_resolution(min: Vec3, max: Vec3, res: usize) -> Result<Grid, Error> {
+        check_bounds(min, max)?;
+        if res == 0 {
+            return Err(Error::InvalidGrid("resolution must be at least 1 cell".into()));
+        }
+        let extent = max - min;
+        let h = extent.max_element() / res as f32;
+        let cells = [0, 1, 2].map(|a| ((extent[a] / h) - 1e-4).ceil().max(1.0) as usize);
+        let covered = Vec3::new(cells[0] as f32, cells[1] as f32, cells[2] as f32) * h;
+        let origin = (min + max) * 0.5 - covered * 0.5;
+        Ok(Grid { origin, spacing: Vec3::splat(h), cells })
+    }
+
+    /// Sample points per axis.
+    pub fn points(&self) -> [usize; 3] {
+        [self.cells[0] + 1, self.cells[1] + 1, self.cells[2] + 1]
+    }
+
+    pub fn point_count(&self) -> usize {
+        let p = self.points();
+        p[0] * p[1] * p[2]
+    }
+
+    pub fn cell_count(&self) -> u64 {
+        self.cells.iter().map(|&c| c as u64).product()
+    }
+
+    /// World position of sample point `(i, j, k)`.
+    #[inline]
+    pub fn position(&self, i: usize, j: usize, k: usize) -> Vec3 {
+        self.origin + self.spacing * Vec3::new(i as f32, j as f32, k as f32)
+    }
+
+    /// Linear index of sample point `(i, j, k)`, x fastest.
+    #[inline]
+    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        let p = self.points();
+        i + p[0] * (j + p[1] * k)
+    }
+
+    /// `(i, j, k)` of a linear sample index.
+    pub fn unindex(&self, n: usize) -> [usize; 3] {
+        let p = self.points();
+        [n % p[0], (n / p[0]) % p[1], n / (p[0] * p[1])]
+    }
+
+    /// The far corner of the grid.
+    pub fn max(&self) -> Vec3 {
+        self.position(self.cells[0], self.cells[1], self.cells[2])
+    }
+
+    /// Length of a cell's longest side: the natural unit for "within a cell" tolerances.
+    pub fn cell_size(&self) -> f32 {
+        self.spacing.max_element()
+    }
+
+    /// Fails with [`Error::GridTooLarge`] when the grid exceeds `max_cells`.
+    pub fn check_size(&self, max_cells: u64) -> Result<(), Error> {
+        let cells = self.cell_count();
+        if cells > max_cells {
+            return Err(Error::GridTooLarge { cells, max_cells });
+        }
+        Ok(())
+    }
+}
+
+fn check_bounds(min: Vec3, max: Vec3) -> Result<(), Error> {
+    if !(min.is_finite() && max.is_finite()) {
+        return Err(Error::InvalidGrid(format!("bounds must be finite, got {min} .. {max}")));
+    }
+    if !(max.cmpgt(min).all()) {
+        return Err(Error::InvalidGrid(format!(
+            "bounds must have max > min on every axis, got {min} .. {max}"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolution_counts_cells_on_the_longest_side() {
+        let g = Grid::with_resolution(Vec3::new(-1.0, -0.5, 0.0), Vec3::new(1.0, 0.5, 0.25), 8).unwrap();
+        assert_eq!(g.cells, [8, 4, 1]);
+        assert!((g.spacing.x - 0.25).abs() < 1e-6);
+        assert!((g.max() - Vec3::new(1.0, 0.5, 0.25)).length() < 1e-5);
+    }
+
+    #[test]
+    fn index_round_trips() {
+        let g = Grid::new(Vec3::ZERO, Vec3::ONE, [3, 4, 5]).unwrap();
+        for n in 0..g.point_count() {
+            let [i, j, k] = g.unindex(n);
+            assert_eq!(g.index(i, j, k), n);
+        }
+    }
+
+    #[test]
+    fn rejects_empty_and_inverted_grids() {
+        assert!(Grid::new(Vec3::ZERO, Vec3::ONE, [0, 1, 1]).is_err());
+        assert!(Grid::new(Vec3::ONE, Vec3::ZERO, [1, 1, 1]).is_err());
+        assert!(Grid::with_resolution(Vec3::ZERO, Vec3::ONE, 0).is_err());
+        let g = Grid::new(Vec3::ZERO, Vec3::ONE, [100, 100, 100]).unwrap();
+        assert_eq!(g.check_size(999_999), Err(Error::GridTooLarge { cells: 1_000_000, max_cells: 999_999 }));
+    }
+}

@@ -1,0 +1,30 @@
+//! isoforge: feature-preserving isosurface extraction for Rust and the browser.
+//!
+//! The crate is organised in rooms, each owning one idea:
+//! - [`grid`]: where samples live (bounds, dimensions, index → world mapping, size caps).
+//! - [`field`]: what is sampled (the [`field::Field`] trait, closures, sampled volumes).
+//! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
+//! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
+//! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
+//! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
+//! - [`stats`]: the one JSON-able summary of a meshing run.
+//!
+//! The algorithm core knows nothing of JavaScript; `wasm` (only on wasm32) is a thin binding layer.
+
+pub mod error;
+pub mod field;
+pub mod grid;
+pub mod mc;
+pub mod mesh;
+pub mod scenes;
+pub mod stats;
+pub mod tables;
+
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
+
+pub use error::Error;
+pub use field::Field;
+pub use glam::Vec3;
+pub use grid::Grid;
+pub use mesh::Mesh;

@@ -1,0 +1,244 @@
+//! Plain Marching Cubes: the baseline every other method is measured against.
+//!
+//! One vertex per intersected grid edge, shared by the (up to four) cells around it through rolling
+//! per-layer caches, so the output is indexed from the start and nothing is welded afterwards.
+//!
+//! **Iso-level rule**: a sample is inside when `value < iso`; a sample exactly at the iso-level is
+//! outside. Vertices are kept at least [`MIN_EDGE_FRACTION`] of an edge away from its ends, so a
+//! sample at the iso-level never collapses two vertices into one point (no zero-area triangles) and
+//! the topology stays that of the sign pattern.
+
+use crate::error::Error;
+use crate::field::{check_finite, sample_grid, Field};
+use crate::grid::{Grid, DEFAULT_MAX_CELLS};
+use crate::mesh::Mesh;
+use crate::tables::{triangle_table, triangle_table_with_faces, CellTriangles, CORNERS, EDGES, EDGE_AXIS, FACES};
+use glam::Vec3;
+use web_time::Instant;
+
+/// Smallest distance, as a fraction of the edge, between a vertex and the edge's end points.
+pub const MIN_EDGE_FRACTION: f32 = 1e-3;
+
+/// How ambiguous cell faces are resolved. Both are consistent between neighbours (watertight).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Topology {
+    /// Inside corners on an ambiguous face are always separated: one fixed table, fastest.
+    #[default]
+    Fixed,
+    /// The asymptotic decider picks, per face, the connectivity of the bilinear interpolant on that
+    /// face, so surfaces match the trilinear interpolant on every cell face.
+    Trilinear,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct McOptions {
+    pub iso: f32,
+    pub topology: Topology,
+    /// Refuse grids with more cells than this (see [`crate::grid::DEFAULT_MAX_CELLS`]).
+    pub max_cells: u64,
+}
+
+impl Default for McOptions {
+    fn default() -> Self {
+        McOptions { iso: 0.0, topology: Topology::Fixed, max_cells: DEFAULT_MAX_CELLS }
+    }
+}
+
+/// Milliseconds spent in each phase of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct McTimings {
+    pub sample_ms: f64,
+    pub extract_ms: f64,
+    pub normals_ms: f64,
+}
+
+/// Samples `field` on `grid`, extracts the iso-surface, and takes vertex normals from the field's
+/// gradient (or, when it has none, from the mesh).
+pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result<(Mesh, McTimings), Error> {
+    grid.check_size(options.max_cells)?;
+    let mut timings = McTimings::default();
+    let t0 = Instant::now();
+    let values = sample_grid(field, grid)?;
+    timings.sample_ms = ms_since(t0);
+    let t1 = Instant::now();
+    let mut mesh = extract(&values, grid, options)?;
+    timings.extract_ms = ms_since(t1);
+    let t2 = Instant::now();
+    if mesh.positions.first().is_some_and(|&p| field.gradient(p).is_some()) {
+        mesh.normals = mesh
+            .positions
+            .iter()
+            .map(|&p| field.gradient(p).unwrap_or(Vec3::ZERO).normalize_or_zero())
+            .collect();
+    } else {
+        mesh.compute_normals_from_faces();
+    }
+    timings.normals_ms = ms_since(t2);
+    Ok((mesh, timings))
+}
+
+/// Meshes an already sampled volume (`values` laid out x fastest, see [`Grid::index`]); vertex
+/// normals come from central differences of the samples, interpolated along each edge.
+pub fn mesh_samples(values: &[f32], grid: &Grid, options: &McOptions) -> Result<(Mesh, McTimings), Error> {
+    grid.check_size(options.max_cells)?;
+    check_finite(values, grid)?;
+    let mut timings = McTimings::default();
+    let t1 = Instant::now();
+    let mut mesh = extract(values, grid, options)?;
+    timings.extract_ms = ms_since(t1);
+    let t2 = Instant::now();
+    mesh.normals = mesh.positions.iter().map(|&p| sample_gradient(values, grid, p).normalize_or_zero()).collect();
+    timings.normals_ms = ms_since(t2);
+    Ok((mesh, timings))
+}
+
+pub(crate) fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Central differences at the grid points around `p`, blended trilinearly (one-sided at the border).
+fn sample_gradient(values: &[f32], grid: &Grid, p: Vec3) -> Vec3 {
+    let pts = grid.points();
+    let q = ((p - grid.origin) / grid.spacing).to_array();
+    let base: [usize; 3] = std::array::from_fn(|a| (q[a].max(0.0).floor() as usize).min(grid.cells[a] - 1));
+    let frac: [f32; 3] = std::array::from_fn(|a| (q[a] - base[a] as f32).clamp(0.0, 1.0));
+    let mut g = Vec3::ZERO;
+    for off in CORNERS.iter() {
+        let idx = [base[0] + off[0], base[1] + off[1], base[2] + off[2]];
+        let w: f32 = (0..3).map(|a| if off[a] == 1 { frac[a] } else { 1.0 - frac[a] }).product();
+        if w == 0.0 {
+            continue;
+        }
+        let mut d = Vec3::ZERO;
+        for a in 0..3 {
+            let lo = if idx[a] > 0 { idx[a] - 1 } else { idx[a] };
+            let hi = if idx[a] + 1 < pts[a] { idx[a] + 1 } else { idx[a] };
+            let mut i_lo = idx;
+            let mut i_hi = idx;
+            i_lo[a] = lo;
+            i_hi[a] = hi;
+            let v_lo = values[grid.index(i_lo[0], i_lo[1], i_lo[2])];
+            let v_hi = values[grid.index(i_hi[0], i_hi[1], i_hi[2])];
+            d[a] = (v_hi - v_lo) / ((hi - lo) as f32 * grid.spacing[a]);
+        }
+        g += d * w;
+    }
+    g
+}
+
+const NONE: u32 = u32::MAX;
+
+/// Vertex ids of the edges starting at the points of two point layers (x and y edges) and of the
+/// z edges between them; swapped as the sweep moves up one layer.
+struct EdgeCache {
+    nx: usize,
+    /// x- and y-edges of the lower and upper layer: `[layer][axis][i + nx * j]`.
+    layer_edges: [[Vec<u32>; 2]; 2],
+    z_edges: Vec<u32>,
+}
+
+impl EdgeCache {
+    fn new(nx: usize, ny: usize) -> Self {
+        let plane = || vec![NONE; nx * ny];
+        EdgeCache { nx, layer_edges: [[plane(), plane()], [plane(), plane()]], z_edges: plane() }
+    }
+
+    fn advance(&mut self) {
+        self.layer_edges.swap(0, 1);
+        for plane in self.layer_edges[1].iter_mut().chain(std::iter::once(&mut self.z_edges)) {
+            plane.fill(NONE);
+        }
+    }
+
+    /// The slot of cell-local edge `e` of the cell whose lowest corner is `(i, j)` in the current slab.
+    #[inline]
+    fn slot(&mut self, i: usize, j: usize, e: usize) -> &mut u32 {
+        let lo = CORNERS[EDGES[e][0] as usize];
+        let at = (i + lo[0]) + self.nx * (j + lo[1]);
+        match EDGE_AXIS[e] {
+            2 => &mut self.z_edges[at],
+            axis => &mut self.layer_edges[lo[2]][axis][at],
+        }
+    }
+}
+
+/// Extracts the `options.iso` level set of a sampled grid.
+pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh, Error> {
+    check_finite(values, grid)?;
+    let [nx, ny, _] = grid.points();
+    let [cx, cy, cz] = grid.cells;
+    let iso = options.iso;
+    let mut mesh = Mesh::default();
+    let mut cache = EdgeCache::new(nx, ny);
+    let fixed = triangle_table();
+    let with_faces = triangle_table_with_faces();
+    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
+
+    for k in 0..cz {
+        if k > 0 {
+            cache.advance();
+        }
+        for j in 0..cy {
+            for i in 0..cx {
+                let base = grid.index(i, j, k);
+                let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - iso);
+                let mut case = 0u8;
+                for (c, &v) in d.iter().enumerate() {
+                    case |= ((v < 0.0) as u8) << c;
+                }
+                if case == 0 || case == 255 {
+                    continue;
+                }
+                let tris: &CellTriangles = match options.topology {
+                    Topology::Fixed => &fixed[case as usize],
+                    Topology::Trilinear => &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize],
+                };
+                let mut ids = [NONE; 12];
+                for tri in tris.triangles() {
+                    let mut out = [0u32; 3];
+                    for (o, &e) in out.iter_mut().zip(tri.iter()) {
+                        let e = e as usize;
+                        if ids[e] == NONE {
+                            let slot = cache.slot(i, j, e);
+                            if *slot == NONE {
+                                *slot = mesh.positions.len() as u32;
+                                let [a, b] = EDGES[e];
+                                let (da, db) = (d[a as usize], d[b as usize]);
+                                let t = (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
+                                let [ai, aj, ak] = CORNERS[a as usize];
+                                let pa = grid.position(i + ai, j + aj, k + ak);
+                                let mut step = Vec3::ZERO;
+                                step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
+                                mesh.positions.push(pa + step * t);
+                            }
+                            ids[e] = *slot;
+                        }
+                        *o = ids[e];
+                    }
+                    mesh.triangles.push(out);
+                }
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+/// For each ambiguous face, whether the bilinear interpolant joins the inside corners across the face
+/// (its saddle value is below the iso-level). Computed from the face's corners in the face's own
+/// fixed order, so both cells sharing the face reach the same bit.
+fn joined_faces(case: u8, d: &[f32; 8]) -> u8 {
+    let mut bits = 0u8;
+    for (f, corners) in FACES.iter().enumerate() {
+        if !crate::tables::face_is_ambiguous(case, f) {
+            continue;
+        }
+        let [a, b, c, e] = corners.map(|c| d[c as usize] as f64);
+        // Bilinear saddle value (a, c diagonal; b, e diagonal); sign of numerator over denominator.
+        let saddle = (a * c - b * e) / (a + c - b - e);
+        // The inside corners' diagonal is joined across the face when the saddle is inside too.
+        if saddle < 0.0 {
+            bits |= 1 << f;
+        }
+    }
+    bits
+}

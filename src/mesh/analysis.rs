@@ -1,0 +1,1 @@
+//! Mesh analysis (filled in below).

@@ -1,0 +1,1 @@
+//! Mesh export (filled in below).
