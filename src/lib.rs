@@ -16,6 +16,7 @@ pub mod field;
 pub mod grid;
 pub mod mc;
 pub mod mesh;
+pub mod pipeline;
 pub mod scenes;
 pub mod stats;
 pub mod tables;

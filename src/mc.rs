@@ -52,6 +52,17 @@ pub struct McTimings {
     pub normals_ms: f64,
 }
 
+impl McTimings {
+    /// The phases by name, in the order they ran, for [`crate::stats::Stats`].
+    pub fn phases(&self) -> Vec<(String, f64)> {
+        vec![
+            ("sample".to_string(), self.sample_ms),
+            ("extract".to_string(), self.extract_ms),
+            ("normals".to_string(), self.normals_ms),
+        ]
+    }
+}
+
 /// Samples `field` on `grid`, extracts the iso-surface, and takes vertex normals from the field's
 /// gradient (or, when it has none, from the mesh).
 pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result<(Mesh, McTimings), Error> {

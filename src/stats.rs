@@ -1,1 +1,115 @@
-//! Run statistics.
+//! The one summary of a meshing run, shared by the CLI's `--stats`, the wasm API and the benches.
+//! Field names are a contract (scripts parse them): add freely, never rename.
+
+use crate::field::Field;
+use crate::mesh::analysis;
+use crate::mesh::Mesh;
+use serde::Serialize;
+use web_time::Instant;
+
+/// Which of the costlier checks to run; the cheap ones always run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AnalysisOptions {
+    /// Pairwise triangle intersection test (spatial index, but still the costliest check).
+    pub self_intersections: bool,
+    /// Distance to the true surface and normal deviation (needs field evaluations).
+    pub surface_error: bool,
+}
+
+impl Default for AnalysisOptions {
+    fn default() -> Self {
+        AnalysisOptions { self_intersections: true, surface_error: true }
+    }
+}
+
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Stats {
+    pub method: String,
+    /// Cells along the longest side of the bounds (or of the finest octree level).
+    pub res: usize,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub closed_manifold: bool,
+    pub euler: i64,
+    pub genus: Option<i64>,
+    pub components: usize,
+    pub boundary_edges: usize,
+    pub non_manifold_edges: usize,
+    pub non_manifold_vertices: usize,
+    pub misoriented_edges: usize,
+    pub degenerate_triangles: usize,
+    /// `None` when the check was skipped.
+    pub self_intersections: Option<usize>,
+    pub min_angle_deg: f64,
+    pub max_angle_deg: f64,
+    /// Triangle angles in 5° bins, 0–5°, 5–10°, …, 175–180°.
+    pub angle_histogram_5deg: Vec<u32>,
+    pub aspect_ratio_mean: f64,
+    pub aspect_ratio_max: f64,
+    pub area: f64,
+    pub volume: f64,
+    pub dist_max: Option<f64>,
+    pub dist_rms: Option<f64>,
+    pub normal_dev_deg_p50: Option<f64>,
+    pub normal_dev_deg_p95: Option<f64>,
+    pub normal_dev_deg_max: Option<f64>,
+    /// Wall-clock time of the meshing itself (all phases, analysis excluded).
+    pub ms_total: f64,
+    /// Time per phase of the method, in the order they ran (a JSON object, insertion ordered).
+    #[serde(serialize_with = "phases_as_object")]
+    pub phases_ms: Vec<(String, f64)>,
+    pub ms_analysis: f64,
+}
+
+/// Analyses `mesh` against `field` (its true surface) and bundles the numbers with the timings.
+pub fn compute(
+    method: &str,
+    res: usize,
+    mesh: &Mesh,
+    field: &dyn Field,
+    phases_ms: Vec<(String, f64)>,
+    options: AnalysisOptions,
+) -> Stats {
+    let t0 = Instant::now();
+    let topo = analysis::topology(mesh);
+    let angles = analysis::angle_stats(mesh);
+    let (aspect_mean, aspect_max) = analysis::aspect_ratios(mesh);
+    let intersections = options.self_intersections.then(|| analysis::self_intersections(mesh));
+    let error = (options.surface_error && mesh.triangle_count() > 0).then(|| analysis::surface_error(mesh, field));
+    let ms_total = phases_ms.iter().map(|(_, ms)| ms).sum();
+    Stats {
+        method: method.to_string(),
+        res,
+        vertices: mesh.vertex_count(),
+        triangles: mesh.triangle_count(),
+        closed_manifold: topo.is_closed_manifold(),
+        euler: topo.euler,
+        genus: topo.genus,
+        components: topo.components,
+        boundary_edges: topo.boundary_edges,
+        non_manifold_edges: topo.non_manifold_edges,
+        non_manifold_vertices: topo.non_manifold_vertices,
+        misoriented_edges: topo.misoriented_edges,
+        degenerate_triangles: topo.degenerate_triangles,
+        self_intersections: intersections,
+        min_angle_deg: angles.min_deg,
+        max_angle_deg: angles.max_deg,
+        angle_histogram_5deg: angles.histogram_5deg.to_vec(),
+        aspect_ratio_mean: aspect_mean,
+        aspect_ratio_max: aspect_max,
+        area: analysis::surface_area(mesh),
+        volume: analysis::signed_volume(mesh),
+        dist_max: error.as_ref().map(|e| e.dist_max),
+        dist_rms: error.as_ref().map(|e| e.dist_rms),
+        normal_dev_deg_p50: error.as_ref().map(|e| e.normal_dev_deg_p50),
+        normal_dev_deg_p95: error.as_ref().map(|e| e.normal_dev_deg_p95),
+        normal_dev_deg_max: error.as_ref().map(|e| e.normal_dev_deg_max),
+        ms_total,
+        phases_ms,
+        ms_analysis: crate::mc::ms_since(t0),
+    }
+}
+
+fn phases_as_object<S: serde::Serializer>(phases: &[(String, f64)], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(phases.iter().map(|(k, v)| (k, v)))
+}

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Builds the wasm package into pkg/ (the npm package) and puts it, with three.js, next to the demo.
+set -euo pipefail
+source "$(dirname "$0")/env.sh"
+cd "$ROOT"
+
+log "building isoforge for $WASM_TARGET (release)"
+wasm_cargo build --release --lib --no-default-features
+wasm="$WASM_TARGET_DIR/$WASM_TARGET/release/isoforge.wasm"
+
+log "generating JavaScript bindings into pkg/"
+rm -rf pkg
+wasm-bindgen --target web --out-dir pkg "$wasm"
+if command -v wasm-opt >/dev/null 2>&1; then
+  wasm-opt -O3 --enable-bulk-memory --enable-nontrapping-float-to-int --enable-sign-ext \
+    --enable-mutable-globals pkg/isoforge_bg.wasm -o pkg/isoforge_bg.wasm
+fi
+cp pkg-config/package.json pkg-config/README.md pkg/ 2>/dev/null || true
+[ -f LICENSE ] && cp LICENSE pkg/
+
+log "copying the package and three.js into www/"
+rm -rf www/pkg www/vendor
+mkdir -p www/vendor/three/addons/controls
+cp -r pkg www/pkg
+cp node_modules/three/build/three.module.js node_modules/three/build/three.core.js www/vendor/three/
+cp node_modules/three/examples/jsm/controls/OrbitControls.js www/vendor/three/addons/controls/
+ls -l pkg/isoforge_bg.wasm

@@ -1,0 +1,35 @@
+# Sourced by the other scripts: how to drive cargo for wasm32 on this machine.
+#
+# Where rustup has the wasm32 target (a typical laptop), plain cargo works. Where it cannot have it
+# (these build machines, see ../shared/TOOLCHAIN.md), Debian's rustc-web compiles `std` from its
+# shipped source with -Z build-std. Native builds always keep using the default toolchain.
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export CHROMEDRIVER="${CHROMEDRIVER:-/usr/bin/chromedriver}"
+WASM_TARGET=wasm32-unknown-unknown
+# A separate target dir keeps the two compilers' artefacts apart.
+WASM_TARGET_DIR="$ROOT/target/wasm"
+
+rustup_has_wasm() {
+  command -v rustup >/dev/null 2>&1 && rustup target list --installed 2>/dev/null | grep -qx "$WASM_TARGET"
+}
+
+# wasm_cargo SUBCOMMAND [ARGS...]: cargo for the wasm32 target, whichever way this machine allows.
+wasm_cargo() {
+  local sub="$1"
+  shift
+  if rustup_has_wasm; then
+    CARGO_TARGET_DIR="$WASM_TARGET_DIR" cargo "$sub" --target "$WASM_TARGET" "$@"
+  else
+    PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+      CARGO_TARGET_DIR="$WASM_TARGET_DIR" \
+      /usr/bin/cargo "$sub" --target "$WASM_TARGET" -Z build-std=std,panic_abort "$@"
+  fi
+}
+
+# The exact wasm-bindgen version the crate links against; the CLI must match it.
+wasm_bindgen_version() {
+  awk '/^name = "wasm-bindgen"$/ { getline; gsub(/version = |"/, ""); print; exit }' "$ROOT/Cargo.lock"
+}
+
+log() { printf '\033[1m==> %s\033[0m\n' "$*"; }

@@ -1,0 +1,51 @@
+//! Helpers shared by the integration suites, which run both natively and as wasm-bindgen-test in
+//! headless Chromium (each suite imports `wasm_bindgen_test as test` on wasm32).
+#![allow(dead_code)]
+
+use isoforge::mesh::analysis;
+use isoforge::Mesh;
+
+/// A small seeded generator (splitmix64): reproducible random inputs without a dependency.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * ((self.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
+    }
+
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+}
+
+/// Asserts the properties every closed output must have, with a message naming what broke.
+pub fn assert_watertight(mesh: &Mesh, what: &str) -> analysis::Topology {
+    let topo = analysis::topology(mesh);
+    assert!(
+        topo.is_closed_manifold(),
+        "{what}: not a closed manifold: {} boundary, {} non-manifold edges, {} misoriented edges, {} non-manifold vertices",
+        topo.boundary_edges,
+        topo.non_manifold_edges,
+        topo.misoriented_edges,
+        topo.non_manifold_vertices
+    );
+    assert_eq!(topo.degenerate_triangles, 0, "{what}: degenerate triangles");
+    assert_eq!(analysis::self_intersections(mesh), 0, "{what}: self-intersections");
+    if mesh.triangle_count() > 0 {
+        assert!(analysis::signed_volume(mesh) > 0.0, "{what}: not oriented outward");
+    }
+    topo
+}

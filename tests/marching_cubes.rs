@@ -1,0 +1,219 @@
+//! Marching Cubes must be watertight on every input: every sign configuration, random grids, values
+//! exactly at the iso-level, and the analytic scenes with their known topology.
+
+mod common;
+
+use common::{assert_watertight, Rng};
+use isoforge::field::sample_grid;
+use isoforge::mc::{self, McOptions, Topology};
+use isoforge::mesh::analysis;
+use isoforge::{scenes, Error, Grid, Vec3};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+
+const TOPOLOGIES: [Topology; 2] = [Topology::Fixed, Topology::Trilinear];
+
+fn options(topology: Topology) -> McOptions {
+    McOptions { topology, ..McOptions::default() }
+}
+
+/// Connected components of the inside corners of one cell under 6-adjacency (cube edges).
+fn edge_connected_components(case: u8) -> usize {
+    let mut parent: [usize; 8] = std::array::from_fn(|c| c);
+    fn find(p: &mut [usize; 8], c: usize) -> usize {
+        if p[c] != c {
+            p[c] = find(p, p[c]);
+        }
+        p[c]
+    }
+    for [a, b] in isoforge::tables::EDGES {
+        if case >> a & 1 == 1 && case >> b & 1 == 1 {
+            let (ra, rb) = (find(&mut parent, a as usize), find(&mut parent, b as usize));
+            parent[ra] = rb;
+        }
+    }
+    (0..8).filter(|&c| case >> c & 1 == 1 && find(&mut parent, c) == c).count()
+}
+
+/// The cell of a 3×3×3-cell grid whose corners carry `case` (inside = negative), everything else
+/// outside, so the surface stays away from the grid boundary.
+fn single_cell_grid(case: u8, rng: &mut Rng) -> (Grid, Vec<f32>) {
+    let grid = Grid::new(Vec3::ZERO, Vec3::splat(3.0), [3, 3, 3]).unwrap();
+    let mut values = vec![0.0; grid.point_count()];
+    for (n, v) in values.iter_mut().enumerate() {
+        let [i, j, k] = grid.unindex(n);
+        let corner = [i, j, k].iter().all(|&c| c == 1 || c == 2);
+        let bit = (i == 2) as u8 | ((j == 2) as u8) << 1 | ((k == 2) as u8) << 2;
+        *v = if corner && case >> bit & 1 == 1 { rng.range(-1.0, -0.05) } else { rng.range(0.05, 1.0) };
+    }
+    (grid, values)
+}
+
+#[test]
+fn all_256_configurations_give_closed_oriented_spheres() {
+    let mut rng = Rng::new(256);
+    for case in 0..=255u8 {
+        for topology in TOPOLOGIES {
+            for _ in 0..3 {
+                let (grid, values) = single_cell_grid(case, &mut rng);
+                let (mesh, _) = mc::mesh_samples(&values, &grid, &options(topology)).unwrap();
+                let what = format!("case {case:#010b} {topology:?}");
+                let topo = assert_watertight(&mesh, &what);
+                // Every piece is a topological sphere.
+                assert_eq!(topo.euler, 2 * topo.components as i64, "{what}");
+                if topology == Topology::Fixed {
+                    assert_eq!(topo.components, edge_connected_components(case), "{what}");
+                }
+            }
+        }
+    }
+}
+
+/// Random grids, their border forced outside; `levels` > 0 quantises values so that many samples sit
+/// exactly on the iso-level (the documented rule: equal counts as outside).
+fn random_grid(rng: &mut Rng, n: usize, levels: u32) -> (Grid, Vec<f32>) {
+    let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [n, n, n]).unwrap();
+    let values = (0..grid.point_count())
+        .map(|idx| {
+            let ijk = grid.unindex(idx);
+            if ijk.iter().any(|&c| c == 0 || c == n) {
+                return 1.0;
+            }
+            let v = rng.range(-1.0, 1.0);
+            if levels > 0 {
+                (v * levels as f32).round() / levels as f32
+            } else {
+                v
+            }
+        })
+        .collect();
+    (grid, values)
+}
+
+#[test]
+fn random_grids_are_watertight() {
+    let mut rng = Rng::new(7);
+    for trial in 0..24 {
+        let levels = [0, 1, 2][trial % 3];
+        let (grid, values) = random_grid(&mut rng, 6 + trial % 5, levels);
+        for topology in TOPOLOGIES {
+            let (mesh, _) = mc::mesh_samples(&values, &grid, &options(topology)).unwrap();
+            assert!(mesh.triangle_count() > 0);
+            assert_watertight(&mesh, &format!("trial {trial} levels {levels} {topology:?}"));
+        }
+    }
+}
+
+#[test]
+fn iso_level_shifts_the_surface_and_equal_values_make_no_degenerate_triangles() {
+    // Integer-valued distance to the centre along each axis (Chebyshev): many samples equal each iso.
+    let grid = Grid::new(Vec3::splat(-4.0), Vec3::splat(4.0), [8, 8, 8]).unwrap();
+    let f = |p: Vec3| p.abs().max_element();
+    let values = sample_grid(&f, &grid).unwrap();
+    let mut previous_volume = 0.0;
+    for iso in [1.0f32, 2.0, 3.0] {
+        let opts = McOptions { iso, ..McOptions::default() };
+        let (mesh, _) = mc::mesh_samples(&values, &grid, &opts).unwrap();
+        let topo = assert_watertight(&mesh, &format!("iso {iso}"));
+        assert_eq!(topo.euler, 2);
+        let volume = analysis::signed_volume(&mesh);
+        assert!(volume > previous_volume, "volume must grow with the iso-level");
+        previous_volume = volume;
+    }
+}
+
+#[test]
+fn sphere_torus_and_clipped_gyroid_have_the_right_euler_characteristic() {
+    for (name, res) in [("sphere", 16), ("sphere", 40), ("torus", 24), ("torus", 48), ("cube_minus_sphere", 24)] {
+        let scene = scenes::scene(name).unwrap();
+        let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+        for topology in TOPOLOGIES {
+            let (mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &options(topology)).unwrap();
+            let topo = assert_watertight(&mesh, &format!("{name} at {res}"));
+            assert_eq!(Some(topo.euler), scene.euler, "{name} at {res} {topology:?}");
+        }
+    }
+    // The clipped gyroid has no closed-form Euler characteristic: compare with an independent count
+    // from the cubical complex of inside samples (twice the solid's χ for a closed surface).
+    let gyroid = scenes::scene("gyroid").unwrap();
+    let grid = Grid::with_resolution(gyroid.min, gyroid.max, 64).unwrap();
+    let values = sample_grid(gyroid.field.as_ref(), &grid).unwrap();
+    let (mesh, _) = mc::mesh_samples(&values, &grid, &McOptions::default()).unwrap();
+    let topo = assert_watertight(&mesh, "gyroid");
+    assert_eq!(topo.euler, 2 * analysis::digital_euler(&values, &grid, 0.0));
+    assert!(topo.euler < 0, "a clipped gyroid has handles, got χ = {}", topo.euler);
+}
+
+#[test]
+fn touching_spheres_share_no_non_manifold_vertex() {
+    let scene = scenes::scene("two_spheres_touching").unwrap();
+    // Odd and even resolutions: the touching point lands on a grid point, an edge or inside a cell.
+    for res in [8, 9, 16, 17, 32, 33] {
+        let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+        for topology in TOPOLOGIES {
+            let (mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &options(topology)).unwrap();
+            let topo = assert_watertight(&mesh, &format!("touching spheres at {res} {topology:?}"));
+            assert_eq!(topo.non_manifold_vertices, 0);
+            assert!(topo.components == 1 || topo.components == 2);
+            assert_eq!(topo.euler, 2 * topo.components as i64);
+        }
+    }
+}
+
+#[test]
+fn sphere_vertices_converge_to_the_true_surface() {
+    let scene = scenes::scene("sphere").unwrap();
+    let mut previous = f64::INFINITY;
+    for res in [8, 16, 32, 64] {
+        let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+        let (mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+        let worst_vertex = mesh
+            .positions
+            .iter()
+            .map(|p| (p.length() as f64 - 0.8).abs())
+            .fold(0.0, f64::max);
+        let h = grid.cell_size() as f64;
+        // Linear interpolation of a distance function along an edge errs by O(h²/r).
+        assert!(worst_vertex < 0.25 * h * h / 0.8 + 1e-5, "res {res}: {worst_vertex} vs h {h}");
+        assert!(worst_vertex < previous / 2.5, "res {res}: error must shrink ~4x per halving");
+        previous = worst_vertex;
+        let err = analysis::surface_error(&mesh, scene.field.as_ref());
+        assert!(err.dist_max < 0.1 * h, "res {res}: dist_max {} vs h {h}", err.dist_max);
+    }
+}
+
+#[test]
+fn sampled_and_functional_paths_agree() {
+    let scene = scenes::scene("torus").unwrap();
+    let grid = Grid::with_resolution(scene.min, scene.max, 20).unwrap();
+    let (from_field, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+    let values = sample_grid(scene.field.as_ref(), &grid).unwrap();
+    let (from_samples, _) = mc::mesh_samples(&values, &grid, &McOptions::default()).unwrap();
+    assert_eq!(from_field.positions, from_samples.positions);
+    assert_eq!(from_field.triangles, from_samples.triangles);
+    // Normals: exact gradient vs interpolated central differences agree to a few degrees.
+    for (a, b) in from_field.normals.iter().zip(&from_samples.normals) {
+        assert!(a.dot(*b) > 0.97, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn bad_input_is_reported_not_meshed() {
+    let grid = Grid::new(Vec3::ZERO, Vec3::ONE, [2, 2, 2]).unwrap();
+    let mut values = vec![1.0f32; 27];
+    values[grid.index(1, 2, 0)] = f32::INFINITY;
+    match mc::mesh_samples(&values, &grid, &McOptions::default()) {
+        Err(Error::NonFiniteSample { index, .. }) => assert_eq!(index, [1, 2, 0]),
+        other => panic!("expected a non-finite sample error, got {other:?}"),
+    }
+    assert!(matches!(
+        mc::mesh_samples(&values[..26], &grid, &McOptions::default()),
+        Err(Error::InvalidGrid(_))
+    ));
+    let opts = McOptions { max_cells: 7, ..McOptions::default() };
+    assert!(matches!(mc::mesh_samples(&[1.0; 27], &grid, &opts), Err(Error::GridTooLarge { cells: 8, .. })));
+    assert!(scenes::scene("no_such_scene").is_err());
+}
