@@ -11,6 +11,7 @@
 //!
 //! The algorithm core knows nothing of JavaScript; `wasm` (only on wasm32) is a thin binding layer.
 
+pub mod emc;
 pub mod error;
 pub mod field;
 pub mod grid;

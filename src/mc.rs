@@ -108,7 +108,7 @@ pub(crate) fn ms_since(t: Instant) -> f64 {
 }
 
 /// Central differences at the grid points around `p`, blended trilinearly (one-sided at the border).
-fn sample_gradient(values: &[f32], grid: &Grid, p: Vec3) -> Vec3 {
+pub(crate) fn sample_gradient(values: &[f32], grid: &Grid, p: Vec3) -> Vec3 {
     let pts = grid.points();
     let q = ((p - grid.origin) / grid.spacing).to_array();
     let base: [usize; 3] = std::array::from_fn(|a| (q[a].max(0.0).floor() as usize).min(grid.cells[a] - 1));
@@ -137,11 +137,11 @@ fn sample_gradient(values: &[f32], grid: &Grid, p: Vec3) -> Vec3 {
     g
 }
 
-const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// Vertex ids of the edges starting at the points of two point layers (x and y edges) and of the
 /// z edges between them; swapped as the sweep moves up one layer.
-struct EdgeCache {
+pub(crate) struct EdgeCache {
     nx: usize,
     /// x- and y-edges of the lower and upper layer: `[layer][axis][i + nx * j]`.
     layer_edges: [[Vec<u32>; 2]; 2],
@@ -149,12 +149,12 @@ struct EdgeCache {
 }
 
 impl EdgeCache {
-    fn new(nx: usize, ny: usize) -> Self {
+    pub(crate) fn new(nx: usize, ny: usize) -> Self {
         let plane = || vec![NONE; nx * ny];
         EdgeCache { nx, layer_edges: [[plane(), plane()], [plane(), plane()]], z_edges: plane() }
     }
 
-    fn advance(&mut self) {
+    pub(crate) fn advance(&mut self) {
         self.layer_edges.swap(0, 1);
         for plane in self.layer_edges[1].iter_mut().chain(std::iter::once(&mut self.z_edges)) {
             plane.fill(NONE);
@@ -163,7 +163,7 @@ impl EdgeCache {
 
     /// The slot of cell-local edge `e` of the cell whose lowest corner is `(i, j)` in the current slab.
     #[inline]
-    fn slot(&mut self, i: usize, j: usize, e: usize) -> &mut u32 {
+    pub(crate) fn slot(&mut self, i: usize, j: usize, e: usize) -> &mut u32 {
         let lo = CORNERS[EDGES[e][0] as usize];
         let at = (i + lo[0]) + self.nx * (j + lo[1]);
         match EDGE_AXIS[e] {
@@ -237,7 +237,7 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
 /// For each ambiguous face, whether the bilinear interpolant joins the inside corners across the face
 /// (its saddle value is below the iso-level). Computed from the face's corners in the face's own
 /// fixed order, so both cells sharing the face reach the same bit.
-fn joined_faces(case: u8, d: &[f32; 8]) -> u8 {
+pub(crate) fn joined_faces(case: u8, d: &[f32; 8]) -> u8 {
     let mut bits = 0u8;
     for (f, corners) in FACES.iter().enumerate() {
         if !crate::tables::face_is_ambiguous(case, f) {

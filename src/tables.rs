@@ -210,12 +210,18 @@ pub fn triangle_table() -> &'static [CellTriangles; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|case| fan(&polygon_table()[case])))
 }
 
+/// Polygons for every (case, joined-faces) pair, indexed `case << 6 | joined_faces`.
+pub fn polygon_table_with_faces() -> &'static [CellPolygons] {
+    static TABLE: OnceLock<Vec<CellPolygons>> = OnceLock::new();
+    TABLE.get_or_init(|| (0..256 * 64).map(|k| build_cell_polygons((k >> 6) as u8, (k & 63) as u8)).collect())
+}
+
 /// Triangles for every (case, joined-faces) pair: the trilinear-topology option picks the face bits
 /// per cell with the asymptotic decider. 16 384 small entries, built on first use.
 pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
     TABLE.get_or_init(|| {
-        (0..256 * 64).map(|k| fan(&build_cell_polygons((k >> 6) as u8, (k & 63) as u8))).collect()
+        polygon_table_with_faces().iter().map(fan).collect()
     })
 }
 

@@ -1,0 +1,85 @@
+//! The edge-flipping pass of EMC (§4.3): after the fans are in, flip every edge whose two opposite
+//! vertices are feature points, so feature lines become explicit chains of mesh edges.
+
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::collections::HashMap;
+
+/// One pass over all edges; returns how many were flipped. A flip is refused when the new edge
+/// already exists (it would make the mesh non-manifold) or when either new triangle would turn
+/// against the two old ones (a fold-over).
+pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
+    // Directed edge (from, to) → the triangle that has it. Closed manifold meshes have each edge
+    // once in each direction.
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.triangles.len() * 3);
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            directed.insert((tri[k], tri[(k + 1) % 3]), t as u32);
+        }
+    }
+    let candidates: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
+    let mut flips = 0;
+    for (a, b) in candidates {
+        let (Some(&t1), Some(&t2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
+            continue;
+        };
+        let c = opposite(mesh.triangles[t1 as usize], a, b);
+        let d = opposite(mesh.triangles[t2 as usize], b, a);
+        if c == d || !is_feature[c as usize] || !is_feature[d as usize] {
+            continue;
+        }
+        if is_feature[a as usize] && is_feature[b as usize] {
+            continue; // already a feature edge
+        }
+        if directed.contains_key(&(c, d)) || directed.contains_key(&(d, c)) {
+            continue;
+        }
+        let p = |v: u32| mesh.positions[v as usize];
+        let old = normal(p(a), p(b), p(c)) + normal(p(b), p(a), p(d));
+        let new1 = normal(p(c), p(a), p(d));
+        let new2 = normal(p(d), p(b), p(c));
+        if new1.dot(old) <= 0.0 || new2.dot(old) <= 0.0 || new1.dot(new2) <= 0.0 {
+            continue;
+        }
+        mesh.triangles[t1 as usize] = [c, a, d];
+        mesh.triangles[t2 as usize] = [d, b, c];
+        directed.remove(&(a, b));
+        directed.remove(&(b, a));
+        for (edge, t) in [((c, a), t1), ((a, d), t1), ((d, c), t1), ((d, b), t2), ((b, c), t2), ((c, d), t2)] {
+            directed.insert(edge, t);
+        }
+        flips += 1;
+    }
+    flips
+}
+
+fn opposite(tri: [u32; 3], a: u32, b: u32) -> u32 {
+    tri.into_iter().find(|&v| v != a && v != b).expect("triangle holds the edge")
+}
+
+fn normal(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    (b - a).cross(c - a).normalize_or_zero()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flips_the_diagonal_between_two_feature_points_once() {
+        // A square a=0 (0,0) b=1 (1,1) split along a-b; c=2 (1,0) and d=3 (0,1) are feature points.
+        let mut mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            normals: vec![],
+            triangles: vec![[0, 2, 1], [0, 1, 3]],
+        };
+        let feature = [false, false, true, true];
+        assert_eq!(flip_toward_features(&mut mesh, &feature), 1);
+        let has_cd = mesh.triangles.iter().any(|t| t.contains(&2) && t.contains(&3));
+        assert!(has_cd);
+        for t in 0..2 {
+            assert!(mesh.face_normal(t).z > 0.0, "orientation kept");
+        }
+        assert_eq!(flip_toward_features(&mut mesh, &feature), 0, "nothing left to flip");
+    }
+}

@@ -1,0 +1,252 @@
+//! Extended Marching Cubes (Kobbelt, Botsch, Schwanecke, Seidel 2001): Marching Cubes whose cells
+//! detect sharp features from the normals at their edge crossings and, where they find one, place an
+//! extra vertex on the feature and fan the cell's polygon around it. A final pass of edge flips turns
+//! the feature points of neighbouring cells into connected feature lines.
+//!
+//! The topology is exactly plain MC's on the same grid (same polygons from [`crate::tables`]), so
+//! EMC inherits its watertightness; only the geometry inside each cell changes.
+
+pub mod edges;
+pub mod feature;
+pub mod flip;
+
+use crate::error::Error;
+use crate::field::{check_finite, sample_grid, Field};
+use crate::grid::{Grid, DEFAULT_MAX_CELLS};
+use crate::mc::{joined_faces, ms_since, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mesh::Mesh;
+use crate::tables::{polygon_table, polygon_table_with_faces, CellPolygons, CORNERS, EDGES, EDGE_AXIS};
+use edges::{edge_root, field_normal};
+use feature::{classify, feature_point, FeatureKind};
+use glam::Vec3;
+use web_time::Instant;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmcOptions {
+    pub iso: f32,
+    /// Sharp when the normal cone's opening min nᵢ·nⱼ is below this (paper: 0.9).
+    pub theta_sharp: f32,
+    /// Corner when max |nᵢ·n*| exceeds this (paper: 0.7).
+    pub phi_corner: f32,
+    /// Exact edge crossings by root finding (directed distances); `false` interpolates linearly.
+    pub directed: bool,
+    /// Run the edge-flipping pass that makes feature lines explicit.
+    pub flip_edges: bool,
+    pub topology: Topology,
+    pub max_cells: u64,
+}
+
+impl Default for EmcOptions {
+    fn default() -> Self {
+        EmcOptions {
+            iso: 0.0,
+            theta_sharp: 0.9,
+            phi_corner: 0.7,
+            directed: true,
+            flip_edges: true,
+            topology: Topology::Fixed,
+            max_cells: DEFAULT_MAX_CELLS,
+        }
+    }
+}
+
+impl EmcOptions {
+    fn validate(&self) -> Result<(), Error> {
+        let check = |name: &str, v: f32| {
+            if (-1.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err(Error::InvalidOption(format!("{name} is a cosine and must lie in [-1, 1], got {v}")))
+            }
+        };
+        check("thetaSharp", self.theta_sharp)?;
+        check("phiCorner", self.phi_corner)?;
+        if !self.iso.is_finite() {
+            return Err(Error::InvalidOption(format!("iso must be finite, got {}", self.iso)));
+        }
+        Ok(())
+    }
+}
+
+/// An EMC mesh: the triangles plus what it knows about features.
+#[derive(Debug, Clone, Default)]
+pub struct EmcMesh {
+    pub mesh: Mesh,
+    /// Per vertex: was it placed on a detected edge or corner?
+    pub feature_vertex: Vec<bool>,
+    /// Mesh edges joining two feature vertices: the reconstructed feature lines.
+    pub feature_edges: Vec<[u32; 2]>,
+    pub edge_features: usize,
+    pub corner_features: usize,
+    pub flips: usize,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmcTimings {
+    pub sample_ms: f64,
+    pub extract_ms: f64,
+    pub flip_ms: f64,
+}
+
+impl EmcTimings {
+    pub fn phases(&self) -> Vec<(String, f64)> {
+        vec![
+            ("sample".to_string(), self.sample_ms),
+            ("extract".to_string(), self.extract_ms),
+            ("flip".to_string(), self.flip_ms),
+        ]
+    }
+}
+
+/// EMC over a field: directed distances by root finding, normals from its gradient.
+pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh, EmcTimings), Error> {
+    options.validate()?;
+    grid.check_size(options.max_cells)?;
+    let t0 = Instant::now();
+    let values = sample_grid(field, grid)?;
+    let sample_ms = ms_since(t0);
+    let (mesh, mut timings) = run(&values, grid, options, Some(field))?;
+    timings.sample_ms = sample_ms;
+    Ok((mesh, timings))
+}
+
+/// EMC over samples alone: crossings by linear interpolation, normals from the samples' gradient.
+pub fn mesh_samples(values: &[f32], grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh, EmcTimings), Error> {
+    options.validate()?;
+    grid.check_size(options.max_cells)?;
+    check_finite(values, grid)?;
+    run(values, grid, options, None)
+}
+
+fn run(
+    values: &[f32],
+    grid: &Grid,
+    options: &EmcOptions,
+    field: Option<&dyn Field>,
+) -> Result<(EmcMesh, EmcTimings), Error> {
+    let mut timings = EmcTimings::default();
+    let t1 = Instant::now();
+    let mut out = extract(values, grid, options, field);
+    timings.extract_ms = ms_since(t1);
+    let t2 = Instant::now();
+    if options.flip_edges {
+        out.flips = flip::flip_toward_features(&mut out.mesh, &out.feature_vertex);
+    }
+    out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
+    timings.flip_ms = ms_since(t2);
+    Ok((out, timings))
+}
+
+/// Edge crossing: position and unit normal.
+fn crossing(
+    values: &[f32],
+    grid: &Grid,
+    options: &EmcOptions,
+    field: Option<&dyn Field>,
+    cell: [usize; 3],
+    e: usize,
+    d: &[f32; 8],
+) -> (Vec3, Vec3) {
+    let [a, b] = EDGES[e];
+    let (da, db) = (d[a as usize], d[b as usize]);
+    let ca = CORNERS[a as usize];
+    let pa = grid.position(cell[0] + ca[0], cell[1] + ca[1], cell[2] + ca[2]);
+    let mut step = Vec3::ZERO;
+    step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
+    let t = match field {
+        Some(f) if options.directed => edge_root(f, options.iso, pa, pa + step, da, db),
+        _ => (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION),
+    };
+    let p = pa + step * t;
+    let n = match field {
+        Some(f) => field_normal(f, p, grid.cell_size() * 1e-3),
+        None => crate::mc::sample_gradient(values, grid, p).normalize_or_zero(),
+    };
+    (p, n)
+}
+
+fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn Field>) -> EmcMesh {
+    let [nx, ny, _] = grid.points();
+    let [cx, cy, cz] = grid.cells;
+    let mut out = EmcMesh::default();
+    let mut cache = EdgeCache::new(nx, ny);
+    let fixed = polygon_table();
+    let with_faces = polygon_table_with_faces();
+    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
+    let mut normals_of_vertex: Vec<Vec3> = Vec::new();
+
+    for k in 0..cz {
+        if k > 0 {
+            cache.advance();
+        }
+        for j in 0..cy {
+            for i in 0..cx {
+                let base = grid.index(i, j, k);
+                let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - options.iso);
+                let case = d.iter().enumerate().fold(0u8, |acc, (c, &v)| acc | ((v < 0.0) as u8) << c);
+                if case == 0 || case == 255 {
+                    continue;
+                }
+                let polygons: &CellPolygons = match options.topology {
+                    Topology::Fixed => &fixed[case as usize],
+                    Topology::Trilinear => &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize],
+                };
+                let cell_min = grid.position(i, j, k);
+                let cell_max = cell_min + grid.spacing;
+                for poly in polygons.iter() {
+                    let mut ids = [0u32; 12];
+                    for (slot_out, &e) in ids.iter_mut().zip(poly) {
+                        let slot = cache.slot(i, j, e as usize);
+                        if *slot == NONE {
+                            let (p, n) = crossing(values, grid, options, field, [i, j, k], e as usize, &d);
+                            *slot = out.mesh.positions.len() as u32;
+                            out.mesh.positions.push(p);
+                            normals_of_vertex.push(n);
+                            out.feature_vertex.push(false);
+                        }
+                        *slot_out = *slot;
+                    }
+                    let ids = &ids[..poly.len()];
+                    let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
+                    let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
+                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    if kind == FeatureKind::Smooth {
+                        for q in 1..ids.len() - 1 {
+                            out.mesh.triangles.push([ids[0], ids[q], ids[q + 1]]);
+                        }
+                        continue;
+                    }
+                    // One bad solve must not throw a spike: keep the point inside its cell.
+                    let f = feature_point(&pts, &nrm, kind).clamp(cell_min, cell_max);
+                    let fid = out.mesh.positions.len() as u32;
+                    out.mesh.positions.push(f);
+                    normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                    out.feature_vertex.push(true);
+                    match kind {
+                        FeatureKind::Corner => out.corner_features += 1,
+                        _ => out.edge_features += 1,
+                    }
+                    for q in 0..ids.len() {
+                        out.mesh.triangles.push([fid, ids[q], ids[(q + 1) % ids.len()]]);
+                    }
+                }
+            }
+        }
+    }
+    out.mesh.normals = normals_of_vertex;
+    out
+}
+
+/// Mesh edges whose two ends are feature vertices, each once.
+fn feature_edges(mesh: &Mesh, is_feature: &[bool]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .filter(|[a, b]| is_feature[*a as usize] && is_feature[*b as usize])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
