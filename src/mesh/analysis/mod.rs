@@ -4,6 +4,7 @@
 //! Each submodule owns one question:
 //! - [`topology`](mod@topology): is it a closed, oriented 2-manifold, and of which Euler
 //!   characteristic and genus?
+//! - [`self_intersect`]: does the surface cross itself? (driver over [`bvh`] and [`tri_tri`])
 //! - [`digital`]: the Euler characteristic of the sampled inside region, an independent count to
 //!   check a mesher's topology against.
 //!
@@ -11,11 +12,15 @@
 //! Euler characteristics, millions of distances) or compare (orientation signs) lose too much in
 //! `f32`.
 
+pub mod bvh;
 pub mod digital;
+pub mod self_intersect;
 pub mod topology;
+pub mod tri_tri;
 
 #[cfg(test)]
 pub(crate) mod fixtures;
 
 pub use digital::digital_euler;
+pub use self_intersect::{self_intersecting_pairs, self_intersections};
 pub use topology::{degenerate_triangles, topology, Topology};
