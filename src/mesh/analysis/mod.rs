@@ -5,6 +5,7 @@
 //! - [`topology`](mod@topology): is it a closed, oriented 2-manifold, and of which Euler
 //!   characteristic and genus?
 //! - [`self_intersect`]: does the surface cross itself? (driver over [`bvh`] and [`tri_tri`])
+//! - [`quality`]: how well shaped are the triangles, and what area and volume do they enclose?
 //! - [`digital`]: the Euler characteristic of the sampled inside region, an independent count to
 //!   check a mesher's topology against.
 //!
@@ -14,6 +15,7 @@
 
 pub mod bvh;
 pub mod digital;
+pub mod quality;
 pub mod self_intersect;
 pub mod topology;
 pub mod tri_tri;
@@ -22,5 +24,6 @@ pub mod tri_tri;
 pub(crate) mod fixtures;
 
 pub use digital::digital_euler;
+pub use quality::{angle_stats, aspect_ratios, signed_volume, surface_area, AngleStats};
 pub use self_intersect::{self_intersecting_pairs, self_intersections};
 pub use topology::{degenerate_triangles, topology, Topology};
