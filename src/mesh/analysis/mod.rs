@@ -6,6 +6,8 @@
 //!   characteristic and genus?
 //! - [`self_intersect`]: does the surface cross itself? (driver over [`bvh`] and [`tri_tri`])
 //! - [`quality`]: how well shaped are the triangles, and what area and volume do they enclose?
+//! - [`surface_error`](mod@surface_error): how far is the mesh from the true zero set, in position
+//!   and in normal?
 //! - [`digital`]: the Euler characteristic of the sampled inside region, an independent count to
 //!   check a mesher's topology against.
 //!
@@ -17,6 +19,7 @@ pub mod bvh;
 pub mod digital;
 pub mod quality;
 pub mod self_intersect;
+pub mod surface_error;
 pub mod topology;
 pub mod tri_tri;
 
@@ -26,4 +29,5 @@ pub(crate) mod fixtures;
 pub use digital::digital_euler;
 pub use quality::{angle_stats, aspect_ratios, signed_volume, surface_area, AngleStats};
 pub use self_intersect::{self_intersecting_pairs, self_intersections};
+pub use surface_error::{surface_error, SurfaceError};
 pub use topology::{degenerate_triangles, topology, Topology};
