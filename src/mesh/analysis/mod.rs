@@ -31,3 +31,45 @@ pub use quality::{angle_stats, aspect_ratios, signed_volume, surface_area, Angle
 pub use self_intersect::{self_intersecting_pairs, self_intersections};
 pub use surface_error::{surface_error, SurfaceError};
 pub use topology::{degenerate_triangles, topology, Topology};
+
+#[cfg(test)]
+mod scale_tests {
+    use super::*;
+    use crate::mc::{mesh_field, McOptions};
+    use crate::{scenes, Grid};
+    use web_time::Instant;
+
+    /// The brief's scale target: about half a million triangles in a few seconds natively. Ignored
+    /// because a debug build is ten times slower; run with
+    /// `cargo test --release --lib scale -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn half_a_million_triangles() {
+        let scene = scenes::scene("sphere").unwrap();
+        let grid = Grid::with_resolution(scene.min, scene.max, 290).unwrap();
+        let (mesh, _) = mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+        eprintln!("{} triangles", mesh.triangle_count());
+        assert!(mesh.triangle_count() > 400_000);
+        let t = Instant::now();
+        let topo = topology(&mesh);
+        eprintln!("topology {:?} in {:?}", topo.euler, t.elapsed());
+        assert!(topo.is_closed_manifold(), "{topo:?}");
+        let t = Instant::now();
+        let crossings = self_intersections(&mesh);
+        eprintln!("self_intersections {crossings} in {:?}", t.elapsed());
+        assert_eq!(crossings, 0);
+        let t = Instant::now();
+        let angles = angle_stats(&mesh);
+        let (mean, max) = aspect_ratios(&mesh);
+        eprintln!(
+            "quality: angles {:.2}..{:.2}, aspect mean {mean:.3} max {max:.1}, in {:?}",
+            angles.min_deg,
+            angles.max_deg,
+            t.elapsed()
+        );
+        let t = Instant::now();
+        let error = surface_error(&mesh, scene.field.as_ref());
+        eprintln!("surface_error {error:?} in {:?}", t.elapsed());
+        assert!(error.dist_max < grid.cell_size() as f64);
+    }
+}
