@@ -1,1 +1,0 @@
-//! Mesh analysis (filled in below).

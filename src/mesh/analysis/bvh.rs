@@ -1,0 +1,249 @@
+//! A bounding volume hierarchy over axis-aligned boxes, used to find every pair of overlapping boxes
+//! without comparing all pairs.
+//!
+//! A hierarchy rather than a uniform grid because meshes mix triangle sizes freely (a cube's twelve
+//! big faces next to a finely meshed sphere); median splits keep the depth at `log2(n)` whatever the
+//! sizes, where a grid would have to pick one cell size for all.
+
+use glam::Vec3;
+
+/// A closed axis-aligned box. Boxes that merely touch overlap, so candidates are never missed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    pub fn of_points(points: &[Vec3]) -> Aabb {
+        points.iter().fold(Aabb::EMPTY, |b, &p| Aabb {
+            min: b.min.min(p),
+            max: b.max.max(p),
+        })
+    }
+
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    #[inline]
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
+
+    fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+}
+
+/// Leaves hold at most this many boxes: small enough that leaf-against-leaf work stays cheap, large
+/// enough that the tree is not mostly inner nodes.
+const LEAF_SIZE: usize = 4;
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
+    /// Leaf: first item in `items`. Inner: index of the right child (the left one follows the node).
+    first_or_right: u32,
+    /// Items in the leaf; 0 marks an inner node.
+    count: u32,
+}
+
+/// The hierarchy; item ids are indices into the box slice it was built from.
+pub struct Bvh {
+    nodes: Vec<Node>,
+    items: Vec<u32>,
+}
+
+impl Bvh {
+    pub fn build(boxes: &[Aabb]) -> Bvh {
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(2 * boxes.len() / LEAF_SIZE + 1),
+            items: (0..boxes.len() as u32).collect(),
+        };
+        if !boxes.is_empty() {
+            let mut items = std::mem::take(&mut bvh.items);
+            bvh.build_node(boxes, &mut items, 0);
+            bvh.items = items;
+        }
+        bvh
+    }
+
+    /// Builds the subtree over `items` (which start at `offset` in the final item list), splitting
+    /// at the median centre along the axis where the centres spread most.
+    fn build_node(&mut self, boxes: &[Aabb], items: &mut [u32], offset: usize) -> u32 {
+        let bounds = items
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]));
+        let id = self.nodes.len() as u32;
+        self.nodes.push(Node {
+            bounds,
+            first_or_right: offset as u32,
+            count: items.len() as u32,
+        });
+        if items.len() <= LEAF_SIZE {
+            return id;
+        }
+        let centers = items.iter().fold(Aabb::EMPTY, |b, &i| {
+            let c = boxes[i as usize].center();
+            Aabb {
+                min: b.min.min(c),
+                max: b.max.max(c),
+            }
+        });
+        let spread = centers.max - centers.min;
+        let axis = if spread.x >= spread.y && spread.x >= spread.z {
+            0
+        } else if spread.y >= spread.z {
+            1
+        } else {
+            2
+        };
+        let mid = items.len() / 2;
+        items.select_nth_unstable_by(mid, |&a, &b| {
+            let ca = boxes[a as usize].center()[axis];
+            let cb = boxes[b as usize].center()[axis];
+            ca.total_cmp(&cb)
+        });
+        let (left, right) = items.split_at_mut(mid);
+        self.build_node(boxes, left, offset);
+        let right_id = self.build_node(boxes, right, offset + mid);
+        self.nodes[id as usize].first_or_right = right_id;
+        self.nodes[id as usize].count = 0;
+        id
+    }
+
+    /// Calls `visit(i, j)` once for every unordered pair `i != j` of overlapping boxes.
+    pub fn overlapping_pairs(&self, boxes: &[Aabb], mut visit: impl FnMut(u32, u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = vec![(0u32, 0u32)];
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
+            if a == b {
+                if na.count > 0 {
+                    let leaf = self.leaf_items(&na);
+                    for (k, &i) in leaf.iter().enumerate() {
+                        for &j in &leaf[k + 1..] {
+                            if boxes[i as usize].overlaps(&boxes[j as usize]) {
+                                visit(i, j);
+                            }
+                        }
+                    }
+                } else {
+                    let (l, r) = (a + 1, na.first_or_right);
+                    stack.extend([(l, l), (r, r), (l, r)]);
+                }
+                continue;
+            }
+            if !na.bounds.overlaps(&nb.bounds) {
+                continue;
+            }
+            match (na.count > 0, nb.count > 0) {
+                (true, true) => {
+                    for &i in self.leaf_items(&na) {
+                        for &j in self.leaf_items(&nb) {
+                            if boxes[i as usize].overlaps(&boxes[j as usize]) {
+                                visit(i, j);
+                            }
+                        }
+                    }
+                }
+                // Descend the inner node; of two inner nodes, the one with the larger box.
+                (false, true) => stack.extend([(a + 1, b), (na.first_or_right, b)]),
+                (true, false) => stack.extend([(a, b + 1), (a, nb.first_or_right)]),
+                (false, false) => {
+                    if half_area(&na.bounds) >= half_area(&nb.bounds) {
+                        stack.extend([(a + 1, b), (na.first_or_right, b)]);
+                    } else {
+                        stack.extend([(a, b + 1), (a, nb.first_or_right)]);
+                    }
+                }
+            }
+        }
+    }
+
+    fn leaf_items(&self, node: &Node) -> &[u32] {
+        let start = node.first_or_right as usize;
+        &self.items[start..start + node.count as usize]
+    }
+}
+
+fn half_area(b: &Aabb) -> f32 {
+    let d = b.max - b.min;
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic pseudo-random boxes of mixed sizes.
+    fn boxes(n: usize) -> Vec<Aabb> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|i| {
+                let c = Vec3::new(next(), next(), next()) * 10.0;
+                let size = if i % 17 == 0 { 3.0 } else { 0.4 };
+                let h = Vec3::new(next(), next(), next()) * size;
+                Aabb {
+                    min: c - h,
+                    max: c + h,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn finds_exactly_the_brute_force_pairs() {
+        for n in [0, 1, 2, 5, 37, 400] {
+            let b = boxes(n);
+            let bvh = Bvh::build(&b);
+            let mut found = Vec::new();
+            bvh.overlapping_pairs(&b, |i, j| found.push((i.min(j), i.max(j))));
+            found.sort_unstable();
+            let before = found.len();
+            found.dedup();
+            assert_eq!(found.len(), before, "a pair was reported twice");
+            let mut expected = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    if b[i].overlaps(&b[j]) {
+                        expected.push((i as u32, j as u32));
+                    }
+                }
+            }
+            assert_eq!(found, expected, "n = {n}");
+            if n == 400 {
+                assert!(
+                    expected.len() > 100,
+                    "the test needs overlaps to mean anything"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn touching_boxes_overlap() {
+        let a = Aabb::of_points(&[Vec3::ZERO, Vec3::ONE]);
+        let b = Aabb::of_points(&[Vec3::ONE, Vec3::splat(2.0)]);
+        let c = Aabb::of_points(&[Vec3::new(1.001, 0.0, 0.0), Vec3::splat(2.0)]);
+        assert!(a.overlaps(&b));
+        assert!(!a.overlaps(&c));
+    }
+}

@@ -1,0 +1,189 @@
+//! Does the surface cross itself? Candidate pairs come from a [`Bvh`] over the triangles' boxes;
+//! each candidate is decided in `f64` by [`super::tri_tri`].
+//!
+//! Which pairs are tested depends on how many vertex indices they share:
+//! - none: any common point (touching included) is an intersection;
+//! - exactly one: an intersection when they overlap beyond that vertex (a fold, a fan wound twice,
+//!   a spike through a neighbour), see [`overlap_beyond_shared_vertex`];
+//! - two or three: never (neighbours across an edge, or duplicates, are the topology's business).
+//!
+//! Vertices are identified by index, so an unwelded mesh (one copy of a vertex per triangle) reports
+//! every pair of neighbours as touching: weld it first. Collapsed triangles (repeated index) are
+//! skipped; zero-area triangles with distinct indices are tested as the segments they are.
+
+use super::bvh::{Aabb, Bvh};
+use super::tri_tri::{overlap_beyond_shared_vertex, triangles_intersect};
+use crate::mesh::Mesh;
+use glam::DVec3;
+
+/// Number of intersecting triangle pairs, by the rules of this module: pairs sharing no vertex that
+/// touch or cross, plus pairs sharing one vertex that overlap beyond it.
+pub fn self_intersections(mesh: &Mesh) -> usize {
+    self_intersecting_pairs(mesh).len()
+}
+
+/// The intersecting pairs `[i, j]` (triangle indices, `i < j`), sorted: for highlighting them.
+pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
+    let ids: Vec<u32> = (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            let [a, b, c] = mesh.triangles[t as usize];
+            a != b && b != c && a != c
+        })
+        .collect();
+    let boxes: Vec<Aabb> = ids
+        .iter()
+        .map(|&t| Aabb::of_points(&mesh.corners(t as usize)))
+        .collect();
+    let bvh = Bvh::build(&boxes);
+    let mut pairs = Vec::new();
+    bvh.overlapping_pairs(&boxes, |i, j| {
+        let (s, t) = (ids[i as usize], ids[j as usize]);
+        if pair_intersects(mesh, s as usize, t as usize) {
+            pairs.push([s.min(t), s.max(t)]);
+        }
+    });
+    pairs.sort_unstable();
+    pairs
+}
+
+fn pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
+    let (ts, tt) = (mesh.triangles[s], mesh.triangles[t]);
+    let mut shared = None;
+    let mut count = 0;
+    for (i, v) in ts.iter().enumerate() {
+        if let Some(j) = tt.iter().position(|w| w == v) {
+            shared = Some((i, j));
+            count += 1;
+        }
+    }
+    let corners = |t: usize| mesh.corners(t).map(|p| p.as_dvec3());
+    match (count, shared) {
+        (0, _) => triangles_intersect(&corners(s), &corners(t)),
+        (1, Some((i, j))) => {
+            let (a, b) = (corners(s), corners(t));
+            let rest = |c: [DVec3; 3], k: usize| [c[(k + 1) % 3] - c[k], c[(k + 2) % 3] - c[k]];
+            overlap_beyond_shared_vertex(&rest(a, i), &rest(b, j))
+        }
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::analysis::fixtures::*;
+    use glam::Vec3;
+
+    #[test]
+    fn closed_solids_do_not_intersect_themselves() {
+        for m in [tetrahedron(), octahedron(), cube()] {
+            assert_eq!(self_intersections(&m), 0);
+        }
+    }
+
+    #[test]
+    fn overlapping_tetrahedra_intersect_and_distant_ones_do_not() {
+        let tet = tetrahedron();
+        let crossing = merged(&tet, &translated(&tet, Vec3::splat(0.2)));
+        let pairs = self_intersecting_pairs(&crossing);
+        assert!(!pairs.is_empty());
+        // Every reported pair joins one face of each tetrahedron.
+        assert!(pairs.iter().all(|&[i, j]| i < 4 && j >= 4), "{pairs:?}");
+        let apart = merged(&tet, &translated(&tet, Vec3::new(1.5, 0.0, 0.0)));
+        assert_eq!(self_intersections(&apart), 0);
+        // Touching at a point without sharing the vertex index counts as intersecting.
+        let touching = merged(&tet, &translated(&tet, Vec3::new(1.0, 0.0, 0.0)));
+        assert!(self_intersections(&touching) > 0);
+    }
+
+    #[test]
+    fn a_fold_at_a_shared_vertex_is_found() {
+        // A fan of two triangles around vertex 0; the second is folded back over the first.
+        let folded = mesh(
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 0.2, 0.0],
+                [0.2, 1.0, 0.0],
+            ],
+            &[[0, 1, 2], [0, 4, 3]],
+        );
+        assert_eq!(self_intersecting_pairs(&folded), vec![[0, 1]]);
+        let spread = mesh(
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                [0.0, -1.0, 0.0],
+            ],
+            &[[0, 1, 2], [0, 3, 4]],
+        );
+        assert_eq!(self_intersections(&spread), 0);
+    }
+
+    #[test]
+    fn tetrahedra_sharing_a_vertex_touch_only_there() {
+        let a = tetrahedron();
+        let mut b = a.clone();
+        for p in &mut b.positions {
+            *p = -*p;
+        }
+        let m = merged(&a, &b);
+        // Unwelded: the two apex copies touch, three faces each.
+        assert_eq!(self_intersections(&m), 9);
+        let mut welded = m.clone();
+        for t in &mut welded.triangles {
+            for v in t.iter_mut() {
+                if *v == 4 {
+                    *v = 0;
+                }
+            }
+        }
+        assert_eq!(self_intersections(&welded), 0);
+    }
+
+    #[test]
+    fn edges_crossing_in_a_shared_cell_face_touch() {
+        // Found in a Marching Cubes gyroid: each cell's fan triangulation put a diagonal in the cell
+        // face x = 5, and the two diagonals cross there, so the sheets touch at one point.
+        let touching = mesh(
+            &[
+                [5.0, 0.13, 0.0],
+                [4.0, 0.53, 1.0],
+                [5.0, 0.76, 1.0],
+                [5.0, 1.0, 0.64],
+                [6.0, 0.0, 0.57],
+                [5.0, 0.0, 0.08],
+            ],
+            &[[0, 1, 2], [3, 4, 5]],
+        );
+        assert_eq!(self_intersections(&touching), 1);
+        let mut apart = touching.clone();
+        for p in &mut apart.positions[3..] {
+            p.x += 0.01;
+        }
+        assert_eq!(self_intersections(&apart), 0);
+    }
+
+    #[test]
+    fn mc_spheres_are_free_of_self_intersections() {
+        for res in [16, 33] {
+            let (m, _) = mc_sphere(res);
+            assert_eq!(self_intersections(&m), 0, "res {res}");
+        }
+    }
+
+    #[test]
+    fn a_pushed_vertex_makes_the_sphere_cross_itself() {
+        let (mut m, _) = mc_sphere(16);
+        let n = m.positions.len();
+        // Drive one vertex through the sphere to the far side.
+        let v = (0..n)
+            .max_by(|&a, &b| m.positions[a].x.total_cmp(&m.positions[b].x))
+            .unwrap();
+        m.positions[v].x -= 1.7;
+        assert!(self_intersections(&m) > 0);
+    }
+}
