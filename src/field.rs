@@ -174,7 +174,13 @@ mod tests {
     #[test]
     fn non_finite_samples_are_named() {
         let grid = Grid::new(Vec3::ZERO, Vec3::ONE, [2, 2, 2]).unwrap();
-        let f = |p: Vec3| if p.x > 0.9 && p.y < 0.1 && p.z < 0.1 { f32::NAN } else { 1.0 };
+        let f = |p: Vec3| {
+            if p.x > 0.9 && p.y < 0.1 && p.z < 0.1 {
+                f32::NAN
+            } else {
+                1.0
+            }
+        };
         let err = sample_grid(&f, &grid).unwrap_err();
         assert!(matches!(err, Error::NonFiniteSample { index: [2, 0, 0], .. }), "{err}");
         assert!(err.to_string().contains("(2, 0, 0)"));

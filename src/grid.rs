@@ -27,11 +27,8 @@ impl Grid {
             )));
         }
         let extent = max - min;
-        let spacing = Vec3::new(
-            extent.x / cells[0] as f32,
-            extent.y / cells[1] as f32,
-            extent.z / cells[2] as f32,
-        );
+        let spacing =
+            Vec3::new(extent.x / cells[0] as f32, extent.y / cells[1] as f32, extent.z / cells[2] as f32);
         Ok(Grid { origin: min, spacing, cells })
     }
 

@@ -12,7 +12,9 @@ use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mesh::Mesh;
-use crate::tables::{triangle_table, triangle_table_with_faces, CellTriangles, CORNERS, EDGES, EDGE_AXIS, FACES};
+use crate::tables::{
+    triangle_table, triangle_table_with_faces, CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
+};
 use glam::Vec3;
 use web_time::Instant;
 
@@ -98,7 +100,8 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, options: &McOptions) -> Result<
     let mut mesh = extract(values, grid, options)?;
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
-    mesh.normals = mesh.positions.iter().map(|&p| sample_gradient(values, grid, p).normalize_or_zero()).collect();
+    mesh.normals =
+        mesh.positions.iter().map(|&p| sample_gradient(values, grid, p).normalize_or_zero()).collect();
     timings.normals_ms = ms_since(t2);
     Ok((mesh, timings))
 }
@@ -202,36 +205,65 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
                 }
                 let tris: &CellTriangles = match options.topology {
                     Topology::Fixed => &fixed[case as usize],
-                    Topology::Trilinear => &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize],
-                };
-                let mut ids = [NONE; 12];
-                for tri in tris.triangles() {
-                    let mut out = [0u32; 3];
-                    for (o, &e) in out.iter_mut().zip(tri.iter()) {
-                        let e = e as usize;
-                        if ids[e] == NONE {
-                            let slot = cache.slot(i, j, e);
-                            if *slot == NONE {
-                                *slot = mesh.positions.len() as u32;
-                                let [a, b] = EDGES[e];
-                                let (da, db) = (d[a as usize], d[b as usize]);
-                                let t = (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
-                                let [ai, aj, ak] = CORNERS[a as usize];
-                                let pa = grid.position(i + ai, j + aj, k + ak);
-                                let mut step = Vec3::ZERO;
-                                step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
-                                mesh.positions.push(pa + step * t);
-                            }
-                            ids[e] = *slot;
-                        }
-                        *o = ids[e];
+                    Topology::Trilinear => {
+                        &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize]
                     }
-                    mesh.triangles.push(out);
+                };
+                let mut ids = [NONE; 13];
+                let mut at = 0;
+                for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
+                    let group = &tris.edges[3 * at..3 * (at + count as usize)];
+                    at += count as usize;
+                    for &e in group.iter().filter(|&&e| e != CENTER) {
+                        let e = e as usize;
+                        if ids[e] != NONE {
+                            continue;
+                        }
+                        let slot = cache.slot(i, j, e);
+                        if *slot == NONE {
+                            *slot = mesh.positions.len() as u32;
+                            mesh.positions.push(edge_point(grid, [i, j, k], e, &d));
+                        }
+                        ids[e] = *slot;
+                    }
+                    if group.contains(&CENTER) {
+                        ids[CENTER as usize] = mesh.positions.len() as u32;
+                        mesh.positions.push(polygon_center(&mesh.positions, group, &ids));
+                    }
+                    for t in group.chunks_exact(3) {
+                        mesh.triangles.push([ids[t[0] as usize], ids[t[1] as usize], ids[t[2] as usize]]);
+                    }
                 }
             }
         }
     }
     Ok(mesh)
+}
+
+/// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.
+fn edge_point(grid: &Grid, cell: [usize; 3], e: usize, d: &[f32; 8]) -> Vec3 {
+    let [a, b] = EDGES[e];
+    let (da, db) = (d[a as usize], d[b as usize]);
+    let t = (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
+    let [ai, aj, ak] = CORNERS[a as usize];
+    let pa = grid.position(cell[0] + ai, cell[1] + aj, cell[2] + ak);
+    let mut step = Vec3::ZERO;
+    step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
+    pa + step * t
+}
+
+/// The centre vertex of a polygon that needs one (see [`crate::tables::CENTER`]): the mean of its
+/// edge vertices, which lies inside the cell because they all lie on its boundary.
+pub(crate) fn polygon_center(positions: &[Vec3], group: &[u8], ids: &[u32; 13]) -> Vec3 {
+    let mut seen = [false; 12];
+    let (mut sum, mut n) = (Vec3::ZERO, 0.0);
+    for &e in group.iter().filter(|&&e| e != CENTER) {
+        if !std::mem::replace(&mut seen[e as usize], true) {
+            sum += positions[ids[e as usize] as usize];
+            n += 1.0;
+        }
+    }
+    sum / n
 }
 
 /// For each ambiguous face, whether the bilinear interpolant joins the inside corners across the face

@@ -72,7 +72,11 @@ impl Request {
 }
 
 /// Meshes a field over `bounds` (unless the request overrides them).
-pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) -> Result<(Mesh, Stats), Error> {
+pub fn mesh_field(
+    field: &dyn Field,
+    bounds: (Vec3, Vec3),
+    request: &Request,
+) -> Result<(Mesh, Stats), Error> {
     let (min, max) = request.bounds.unwrap_or(bounds);
     let grid = Grid::with_resolution(min, max, request.res)?;
     grid.check_size(request.max_cells)?;
@@ -80,7 +84,14 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
         Method::Mc => mc::mesh_field(field, &grid, &request.mc_options())?,
     };
     let shifted = Shifted { field, iso: request.iso };
-    let stats = stats::compute(request.method.name(), request.res, &mesh, &shifted, timings.phases(), request.analysis);
+    let stats = stats::compute(
+        request.method.name(),
+        request.res,
+        &mesh,
+        &shifted,
+        timings.phases(),
+        request.analysis,
+    );
     Ok((mesh, stats))
 }
 
@@ -93,7 +104,8 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<(M
     let field = SampledField { grid: *grid, values };
     let shifted = Shifted { field: &field, iso: request.iso };
     let res = grid.cells.iter().copied().max().unwrap_or(0);
-    let stats = stats::compute(request.method.name(), res, &mesh, &shifted, timings.phases(), request.analysis);
+    let stats =
+        stats::compute(request.method.name(), res, &mesh, &shifted, timings.phases(), request.analysis);
     Ok((mesh, stats))
 }
 

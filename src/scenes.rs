@@ -23,8 +23,10 @@ pub fn scene(name: &str) -> Result<Scene, Error> {
     let (field, euler): (Box<dyn Field + Send + Sync>, Option<i64>) = match name {
         "sphere" => (Box::new(Sphere { center: Vec3::ZERO, radius: 0.8 }), Some(2)),
         "torus" => (Box::new(Torus { major: 0.6, minor: 0.25 }), Some(0)),
-        "gyroid" => (Box::new(ClippedGyroid { frequency: 2.0 * std::f32::consts::PI / 1.2, radius: 0.9 }), None),
-        "cube_minus_sphere" => (Box::new(CubeMinusSphere { half: 0.6, radius: 0.75 }), Some(2)),
+        "gyroid" => {
+            (Box::new(ClippedGyroid { frequency: 2.0 * std::f32::consts::PI / 1.2, radius: 0.9 }), None)
+        }
+        "cube_minus_sphere" => (Box::new(CubeMinusSphere { half: 0.6, radius: 0.75 }), Some(-8)),
         "two_spheres_touching" => (
             Box::new(Union(
                 Sphere { center: Vec3::new(-0.4, 0.0, 0.0), radius: 0.4 },
@@ -106,7 +108,9 @@ impl Field for ClippedGyroid {
     }
 }
 
-/// An axis-aligned cube with a ball carved out of its middle: sharp edges, corners and curved creases.
+/// An axis-aligned cube with a ball carved out of its middle. The ball pokes through all six faces,
+/// so the solid is a frame of genus 5 (Euler characteristic -8) with sharp edges, corners and
+/// curved creases.
 pub struct CubeMinusSphere {
     pub half: f32,
     pub radius: f32,
@@ -132,7 +136,13 @@ pub fn box_distance(p: Vec3, half: Vec3) -> (f32, Vec3) {
         (outside.length(), (outside.normalize() * sign))
     } else {
         let m = q.max_element();
-        let axis = if q.x == m { Vec3::X } else if q.y == m { Vec3::Y } else { Vec3::Z };
+        let axis = if q.x == m {
+            Vec3::X
+        } else if q.y == m {
+            Vec3::Y
+        } else {
+            Vec3::Z
+        };
         (m, axis * sign)
     }
 }

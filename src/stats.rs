@@ -75,7 +75,8 @@ pub fn compute(
     let angles = analysis::angle_stats(mesh);
     let (aspect_mean, aspect_max) = analysis::aspect_ratios(mesh);
     let intersections = options.self_intersections.then(|| analysis::self_intersections(mesh));
-    let error = (options.surface_error && mesh.triangle_count() > 0).then(|| analysis::surface_error(mesh, field));
+    let error =
+        (options.surface_error && mesh.triangle_count() > 0).then(|| analysis::surface_error(mesh, field));
     let ms_total = phases_ms.iter().map(|(_, ms)| ms).sum();
     Stats {
         method: method.to_string(),

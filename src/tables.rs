@@ -24,20 +24,8 @@ pub const CORNERS: [[usize; 3]; 8] = {
 };
 
 /// The 12 cube edges as (lower corner, upper corner); `EDGE_AXIS[e]` is the axis the edge runs along.
-pub const EDGES: [[u8; 2]; 12] = [
-    [0, 1],
-    [2, 3],
-    [4, 5],
-    [6, 7],
-    [0, 2],
-    [1, 3],
-    [4, 6],
-    [5, 7],
-    [0, 4],
-    [1, 5],
-    [2, 6],
-    [3, 7],
-];
+pub const EDGES: [[u8; 2]; 12] =
+    [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
 
 pub const EDGE_AXIS: [usize; 12] = [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2];
 
@@ -127,7 +115,8 @@ pub fn build_cell_polygons(case: u8, joined_faces: u8) -> CellPolygons {
     let mut next = [u8::MAX; 12];
     for (f, corners) in FACES.iter().enumerate() {
         // Walk the face counter-clockwise as seen from outside the cube.
-        let ring: [u8; 4] = if f % 2 == 1 { *corners } else { [corners[0], corners[3], corners[2], corners[1]] };
+        let ring: [u8; 4] =
+            if f % 2 == 1 { *corners } else { [corners[0], corners[3], corners[2], corners[1]] };
         // Crossings in ring order: (edge, leaving = goes from an inside to an outside corner).
         let mut crossings = [(0u8, false); 4];
         let mut n = 0;
@@ -171,12 +160,17 @@ pub fn build_cell_polygons(case: u8, joined_faces: u8) -> CellPolygons {
     polygons
 }
 
-/// Triangles of a case, fanned from each polygon's first vertex: at most 12 edges in at most 4
-/// polygons give at most 10 triangles, 30 edge ids.
+/// Stands for an extra vertex at the centre of its polygon in triangle lists (edge ids are 0..12).
+pub const CENTER: u8 = 12;
+
+/// Triangles of a case: at most 12 edges in at most 4 polygons give at most 12 triangles (with a
+/// centre vertex), 36 ids. Triangles are grouped by polygon, in polygon order (`per_polygon` counts them), so methods
+/// that treat polygons separately (EMC's feature cells) can find each polygon's own triangles.
 #[derive(Clone, Copy, Debug)]
 pub struct CellTriangles {
-    pub edges: [u8; 30],
+    pub edges: [u8; 36],
     pub count: u8,
+    pub per_polygon: [u8; 4],
 }
 
 impl CellTriangles {
@@ -185,13 +179,68 @@ impl CellTriangles {
     }
 }
 
-fn fan(polygons: &CellPolygons) -> CellTriangles {
-    let mut out = CellTriangles { edges: [0; 30], count: 0 };
-    for poly in polygons.iter() {
-        for k in 1..poly.len() - 1 {
+/// The two cube faces edge `e` lies on.
+pub fn edge_faces(e: usize) -> [usize; 2] {
+    let axis = EDGE_AXIS[e];
+    let corner = CORNERS[EDGES[e][0] as usize];
+    let [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+    [2 * u + corner[u], 2 * v + corner[v]]
+}
+
+fn share_face(a: u8, b: u8) -> bool {
+    let (fa, fb) = (edge_faces(a as usize), edge_faces(b as usize));
+    fa.iter().any(|f| fb.contains(f))
+}
+
+/// Triangulates one polygon so that no diagonal joins two vertices on a common cube face: such a
+/// diagonal would lie flat in the face, where the neighbour's triangles lie too, and the two cells'
+/// diagonals could cross there (a self-intersection, though the topology stays fine).
+///
+/// Some long polygons of the trilinear table (8, 9 and 12 sides, winding over several faces) have
+/// no such triangulation; they are fanned around an extra vertex at their centre ([`CENTER`]), as
+/// Marching Cubes 33 does for the same configurations. The default table never needs one.
+pub fn triangulate_polygon(poly: &[u8]) -> Vec<[u8; 3]> {
+    fn split(poly: &[u8], idx: &[usize], out: &mut Vec<[u8; 3]>) -> bool {
+        let n = idx.len();
+        if n == 3 {
+            out.push([poly[idx[0]], poly[idx[1]], poly[idx[2]]]);
+            return true;
+        }
+        // The base idx[0]–idx[n-1] is an edge or an accepted diagonal; pick an apex for it.
+        for k in 1..n - 1 {
+            let left_ok = k == 1 || !share_face(poly[idx[0]], poly[idx[k]]);
+            let right_ok = k == n - 2 || !share_face(poly[idx[k]], poly[idx[n - 1]]);
+            if !(left_ok && right_ok) {
+                continue;
+            }
+            let mark = out.len();
+            out.push([poly[idx[0]], poly[idx[k]], poly[idx[n - 1]]]);
+            if (k < 2 || split(poly, &idx[..=k], out)) && (k > n - 3 || split(poly, &idx[k..], out)) {
+                return true;
+            }
+            out.truncate(mark);
+        }
+        false
+    }
+    let idx: Vec<usize> = (0..poly.len()).collect();
+    let mut out = Vec::with_capacity(poly.len() - 2);
+    if !split(poly, &idx, &mut out) {
+        out.clear();
+        for k in 0..poly.len() {
+            out.push([CENTER, poly[k], poly[(k + 1) % poly.len()]]);
+        }
+    }
+    out
+}
+
+fn triangulate(polygons: &CellPolygons) -> CellTriangles {
+    let mut out = CellTriangles { edges: [0; 36], count: 0, per_polygon: [0; 4] };
+    for (p, poly) in polygons.iter().enumerate() {
+        for tri in triangulate_polygon(poly) {
             let at = 3 * out.count as usize;
-            out.edges[at..at + 3].copy_from_slice(&[poly[0], poly[k], poly[k + 1]]);
+            out.edges[at..at + 3].copy_from_slice(&tri);
             out.count += 1;
+            out.per_polygon[p] += 1;
         }
     }
     out
@@ -207,7 +256,7 @@ pub fn polygon_table() -> &'static [CellPolygons; 256] {
 /// Triangles of the default table.
 pub fn triangle_table() -> &'static [CellTriangles; 256] {
     static TABLE: OnceLock<[CellTriangles; 256]> = OnceLock::new();
-    TABLE.get_or_init(|| std::array::from_fn(|case| fan(&polygon_table()[case])))
+    TABLE.get_or_init(|| std::array::from_fn(|case| triangulate(&polygon_table()[case])))
 }
 
 /// Polygons for every (case, joined-faces) pair, indexed `case << 6 | joined_faces`.
@@ -220,9 +269,7 @@ pub fn polygon_table_with_faces() -> &'static [CellPolygons] {
 /// per cell with the asymptotic decider. 16 384 small entries, built on first use.
 pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        polygon_table_with_faces().iter().map(fan).collect()
-    })
+    TABLE.get_or_init(|| polygon_table_with_faces().iter().map(triangulate).collect())
 }
 
 #[cfg(test)]
@@ -257,6 +304,38 @@ mod tests {
                 for (e, &[a, b]) in EDGES.iter().enumerate() {
                     let crosses = (case >> a & 1) != (case >> b & 1);
                     assert_eq!(used[e], crosses as i32, "case {case} edge {e}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn no_triangle_edge_lies_flat_in_a_cube_face_unless_it_is_a_polygon_edge() {
+        for k in 0..256 * 64 {
+            let polys = build_cell_polygons((k >> 6) as u8, (k & 63) as u8);
+            for poly in polys.iter() {
+                let tris = triangulate_polygon(poly);
+                if tris.iter().any(|t| t.contains(&CENTER)) {
+                    assert_ne!(k & 63, 0, "the default table needs no centre vertex");
+                    assert_eq!(tris.len(), poly.len());
+                    continue;
+                }
+                assert_eq!(tris.len(), poly.len() - 2);
+                let is_polygon_edge = |a: u8, b: u8| {
+                    (0..poly.len()).any(|q| {
+                        let (x, y) = (poly[q], poly[(q + 1) % poly.len()]);
+                        (x, y) == (a, b) || (x, y) == (b, a)
+                    })
+                };
+                for t in &tris {
+                    for q in 0..3 {
+                        let (a, b) = (t[q], t[(q + 1) % 3]);
+                        assert!(
+                            is_polygon_edge(a, b) || !share_face(a, b),
+                            "case {} polygon {poly:?}",
+                            k >> 6
+                        );
+                    }
                 }
             }
         }

@@ -127,7 +127,9 @@ fn iso_level_shifts_the_surface_and_equal_values_make_no_degenerate_triangles() 
 
 #[test]
 fn sphere_torus_and_clipped_gyroid_have_the_right_euler_characteristic() {
-    for (name, res) in [("sphere", 16), ("sphere", 40), ("torus", 24), ("torus", 48), ("cube_minus_sphere", 24)] {
+    for (name, res) in
+        [("sphere", 16), ("sphere", 40), ("torus", 24), ("torus", 48), ("cube_minus_sphere", 24)]
+    {
         let scene = scenes::scene(name).unwrap();
         let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
         for topology in TOPOLOGIES {
@@ -170,18 +172,15 @@ fn sphere_vertices_converge_to_the_true_surface() {
     for res in [8, 16, 32, 64] {
         let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
         let (mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
-        let worst_vertex = mesh
-            .positions
-            .iter()
-            .map(|p| (p.length() as f64 - 0.8).abs())
-            .fold(0.0, f64::max);
+        let worst_vertex = mesh.positions.iter().map(|p| (p.length() as f64 - 0.8).abs()).fold(0.0, f64::max);
         let h = grid.cell_size() as f64;
         // Linear interpolation of a distance function along an edge errs by O(h²/r).
         assert!(worst_vertex < 0.25 * h * h / 0.8 + 1e-5, "res {res}: {worst_vertex} vs h {h}");
         assert!(worst_vertex < previous / 2.5, "res {res}: error must shrink ~4x per halving");
         previous = worst_vertex;
         let err = analysis::surface_error(&mesh, scene.field.as_ref());
-        assert!(err.dist_max < 0.1 * h, "res {res}: dist_max {} vs h {h}", err.dist_max);
+        // Flat triangles between exact vertices: the chord error is also O(h²/r).
+        assert!(err.dist_max < 0.5 * h * h / 0.8, "res {res}: dist_max {} vs h {h}", err.dist_max);
     }
 }
 

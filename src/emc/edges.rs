@@ -29,8 +29,12 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
     let (mut glo, mut ghi) = if flip { (-da, -db) } else { (da, db) };
     // Start from the linear estimate (regula falsi point), which is exact for linear fields.
     let mut t = glo / (glo - ghi);
-    for _ in 0..24 {
+    let mut width = 1.0f32;
+    for _ in 0..48 {
         let gt = g(t);
+        if gt == 0.0 {
+            break;
+        }
         if gt < 0.0 {
             lo = t;
             glo = gt;
@@ -38,7 +42,7 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
             hi = t;
             ghi = gt;
         }
-        if hi - lo < 1e-6 || gt == 0.0 {
+        if hi - lo < 1e-6 {
             break;
         }
         let slope = match field.gradient(a + dir * t) {
@@ -46,17 +50,18 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
             None => (ghi - glo) / (hi - lo),
         };
         let newton = t - gt / slope;
-        t = if slope != 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        // Bisect when Newton leaves the bracket or when the bracket stopped halving (the one-sided
+        // stall of secant-like steps), so convergence is guaranteed.
+        let stalled = hi - lo > 0.5 * width;
+        width = hi - lo;
+        t = if slope != 0.0 && newton > lo && newton < hi && !stalled { newton } else { 0.5 * (lo + hi) };
     }
     t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION)
 }
 
 /// Unit normal of the field at `p`: its gradient, or central differences when it has none.
 pub fn field_normal(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
-    field
-        .gradient(p)
-        .unwrap_or_else(|| finite_difference_gradient(field, p, h))
-        .normalize_or_zero()
+    field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)).normalize_or_zero()
 }
 
 #[cfg(test)]

@@ -88,7 +88,12 @@ mod tests {
     #[test]
     fn two_planes_meet_in_their_edge() {
         // Planes x = 0.3 and y = 0.6; samples scattered on both.
-        let pts = [Vec3::new(0.3, 0.1, 0.0), Vec3::new(0.3, 0.2, 1.0), Vec3::new(0.0, 0.6, 0.5), Vec3::new(1.0, 0.6, 0.2)];
+        let pts = [
+            Vec3::new(0.3, 0.1, 0.0),
+            Vec3::new(0.3, 0.2, 1.0),
+            Vec3::new(0.0, 0.6, 0.5),
+            Vec3::new(1.0, 0.6, 0.2),
+        ];
         let nrm = [Vec3::X, Vec3::X, Vec3::Y, Vec3::Y];
         assert_eq!(classify(&nrm, 0.9, 0.7), FeatureKind::Edge);
         let p = feature_point(&pts, &nrm, FeatureKind::Edge);

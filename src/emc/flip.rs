@@ -45,7 +45,8 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
         mesh.triangles[t2 as usize] = [d, b, c];
         directed.remove(&(a, b));
         directed.remove(&(b, a));
-        for (edge, t) in [((c, a), t1), ((a, d), t1), ((d, c), t1), ((d, b), t2), ((b, c), t2), ((c, d), t2)] {
+        for (edge, t) in [((c, a), t1), ((a, d), t1), ((d, c), t1), ((d, b), t2), ((b, c), t2), ((c, d), t2)]
+        {
             directed.insert(edge, t);
         }
         flips += 1;
@@ -69,7 +70,12 @@ mod tests {
     fn flips_the_diagonal_between_two_feature_points_once() {
         // A square a=0 (0,0) b=1 (1,1) split along a-b; c=2 (1,0) and d=3 (0,1) are feature points.
         let mut mesh = Mesh {
-            positions: vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
             normals: vec![],
             triangles: vec![[0, 2, 1], [0, 1, 3]],
         };

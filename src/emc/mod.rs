@@ -13,9 +13,12 @@ pub mod flip;
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
-use crate::mc::{joined_faces, ms_since, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mc::{joined_faces, ms_since, polygon_center, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
 use crate::mesh::Mesh;
-use crate::tables::{polygon_table, polygon_table_with_faces, CellPolygons, CORNERS, EDGES, EDGE_AXIS};
+use crate::tables::{
+    polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
+    CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS,
+};
 use edges::{edge_root, field_normal};
 use feature::{classify, feature_point, FeatureKind};
 use glam::Vec3;
@@ -99,7 +102,11 @@ impl EmcTimings {
 }
 
 /// EMC over a field: directed distances by root finding, normals from its gradient.
-pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh, EmcTimings), Error> {
+pub fn mesh_field(
+    field: &dyn Field,
+    grid: &Grid,
+    options: &EmcOptions,
+) -> Result<(EmcMesh, EmcTimings), Error> {
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
@@ -111,7 +118,11 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &EmcOptions) -> Resul
 }
 
 /// EMC over samples alone: crossings by linear interpolation, normals from the samples' gradient.
-pub fn mesh_samples(values: &[f32], grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh, EmcTimings), Error> {
+pub fn mesh_samples(
+    values: &[f32],
+    grid: &Grid,
+    options: &EmcOptions,
+) -> Result<(EmcMesh, EmcTimings), Error> {
     options.validate()?;
     grid.check_size(options.max_cells)?;
     check_finite(values, grid)?;
@@ -170,8 +181,8 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
     let mut cache = EdgeCache::new(nx, ny);
-    let fixed = polygon_table();
-    let with_faces = polygon_table_with_faces();
+    let (fixed, fixed_tris) = (polygon_table(), triangle_table());
+    let (with_faces, with_faces_tris) = (polygon_table_with_faces(), triangle_table_with_faces());
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
 
@@ -187,15 +198,22 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                 if case == 0 || case == 255 {
                     continue;
                 }
-                let polygons: &CellPolygons = match options.topology {
-                    Topology::Fixed => &fixed[case as usize],
-                    Topology::Trilinear => &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize],
+                let (polygons, triangles): (&CellPolygons, &CellTriangles) = match options.topology {
+                    Topology::Fixed => (&fixed[case as usize], &fixed_tris[case as usize]),
+                    Topology::Trilinear => {
+                        let key = (case as usize) << 6 | joined_faces(case, &d) as usize;
+                        (&with_faces[key], &with_faces_tris[key])
+                    }
                 };
+                let mut first_triangle = 0;
                 let cell_min = grid.position(i, j, k);
                 let cell_max = cell_min + grid.spacing;
-                for poly in polygons.iter() {
-                    let mut ids = [0u32; 12];
-                    for (slot_out, &e) in ids.iter_mut().zip(poly) {
+                for (p, poly) in polygons.iter().enumerate() {
+                    let count = triangles.per_polygon[p] as usize;
+                    let group = &triangles.edges[3 * first_triangle..3 * (first_triangle + count)];
+                    first_triangle += count;
+                    let mut by_edge = [NONE; 13];
+                    for &e in poly {
                         let slot = cache.slot(i, j, e as usize);
                         if *slot == NONE {
                             let (p, n) = crossing(values, grid, options, field, [i, j, k], e as usize, &d);
@@ -204,15 +222,25 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                             normals_of_vertex.push(n);
                             out.feature_vertex.push(false);
                         }
-                        *slot_out = *slot;
+                        by_edge[e as usize] = *slot;
                     }
-                    let ids = &ids[..poly.len()];
+                    let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
                     let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     if kind == FeatureKind::Smooth {
-                        for q in 1..ids.len() - 1 {
-                            out.mesh.triangles.push([ids[0], ids[q], ids[q + 1]]);
+                        if group.contains(&CENTER) {
+                            by_edge[CENTER as usize] = out.mesh.positions.len() as u32;
+                            out.mesh.positions.push(polygon_center(&out.mesh.positions, group, &by_edge));
+                            normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                            out.feature_vertex.push(false);
+                        }
+                        for t in group.chunks_exact(3) {
+                            out.mesh.triangles.push([
+                                by_edge[t[0] as usize],
+                                by_edge[t[1] as usize],
+                                by_edge[t[2] as usize],
+                            ]);
                         }
                         continue;
                     }

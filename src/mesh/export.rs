@@ -16,12 +16,7 @@ use std::path::Path;
 pub fn write_obj(mesh: &Mesh, w: &mut dyn Write) -> io::Result<()> {
     let has_normals = check(mesh)?;
     let mut w = BufWriter::new(w);
-    writeln!(
-        w,
-        "# isoforge: {} vertices, {} triangles",
-        mesh.positions.len(),
-        mesh.triangles.len()
-    )?;
+    writeln!(w, "# isoforge: {} vertices, {} triangles", mesh.positions.len(), mesh.triangles.len())?;
     for p in &mesh.positions {
         writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
     }
@@ -85,18 +80,12 @@ pub fn write_stl_binary(mesh: &Mesh, w: &mut dyn Write) -> io::Result<()> {
 pub fn write_ply_binary(mesh: &Mesh, w: &mut dyn Write) -> io::Result<()> {
     let has_normals = check(mesh)?;
     if i32::try_from(mesh.positions.len()).is_err() {
-        return Err(invalid(
-            "PLY 'int' indices cannot address more than 2^31 - 1 vertices",
-        ));
+        return Err(invalid("PLY 'int' indices cannot address more than 2^31 - 1 vertices"));
     }
     let mut w = BufWriter::new(w);
     let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment isoforge\n");
     header += &format!("element vertex {}\n", mesh.positions.len());
-    let names: &[&str] = if has_normals {
-        &["x", "y", "z", "nx", "ny", "nz"]
-    } else {
-        &["x", "y", "z"]
-    };
+    let names: &[&str] = if has_normals { &["x", "y", "z", "nx", "ny", "nz"] } else { &["x", "y", "z"] };
     for name in names {
         header += &format!("property float {name}\n");
     }
@@ -122,11 +111,8 @@ pub fn write_ply_binary(mesh: &Mesh, w: &mut dyn Write) -> io::Result<()> {
 
 /// Writes `mesh` to `path` in the format its extension names (`.obj`, `.stl`, `.ply`, any case).
 pub fn write_by_extension(mesh: &Mesh, path: &Path) -> Result<(), Error> {
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
+    let extension =
+        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     let writer: fn(&Mesh, &mut dyn Write) -> io::Result<()> = match extension.as_str() {
         "obj" => write_obj,
         "stl" => write_stl_binary,
@@ -153,15 +139,8 @@ fn check(mesh: &Mesh) -> io::Result<bool> {
             mesh.normals.len()
         )));
     }
-    if let Some(t) = mesh
-        .triangles
-        .iter()
-        .position(|t| t.iter().any(|&v| v as usize >= n))
-    {
-        return Err(invalid(&format!(
-            "triangle {t} {:?} refers past the {n} vertices",
-            mesh.triangles[t]
-        )));
+    if let Some(t) = mesh.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
+        return Err(invalid(&format!("triangle {t} {:?} refers past the {n} vertices", mesh.triangles[t])));
     }
     Ok(!mesh.normals.is_empty())
 }
@@ -261,10 +240,7 @@ mod tests {
         m.normals = vec![Vec3::X; 2];
         let err = write_obj(&m, &mut Vec::new()).unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
-        assert!(
-            err.to_string().contains("2 normals for 6 vertices"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("2 normals for 6 vertices"), "{err}");
         let mut m = octahedron();
         m.triangles.push([0, 1, 6]);
         let err = write_ply_binary(&m, &mut Vec::new()).unwrap_err();
@@ -277,11 +253,9 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("isoforge-export-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let m = cube();
-        for (name, starts) in [
-            ("a.obj", &b"# isoforge"[..]),
-            ("b.STL", b"isoforge binary STL"),
-            ("c.ply", b"ply\n"),
-        ] {
+        for (name, starts) in
+            [("a.obj", &b"# isoforge"[..]), ("b.STL", b"isoforge binary STL"), ("c.ply", b"ply\n")]
+        {
             let path = dir.join(name);
             write_by_extension(&m, &path).unwrap();
             let bytes = std::fs::read(&path).unwrap();
@@ -292,10 +266,7 @@ mod tests {
             matches!(&err, Error::InvalidOption(msg) if msg.contains("'gltf'") && msg.contains(".ply")),
             "{err}"
         );
-        assert!(matches!(
-            write_by_extension(&m, &dir.join("noext")),
-            Err(Error::InvalidOption(_))
-        ));
+        assert!(matches!(write_by_extension(&m, &dir.join("noext")), Err(Error::InvalidOption(_))));
         let err = write_by_extension(&m, &dir.join("missing").join("e.obj")).unwrap_err();
         assert!(matches!(err, Error::Io(_)), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();

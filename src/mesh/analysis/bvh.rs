@@ -15,23 +15,14 @@ pub struct Aabb {
 }
 
 impl Aabb {
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     pub fn of_points(points: &[Vec3]) -> Aabb {
-        points.iter().fold(Aabb::EMPTY, |b, &p| Aabb {
-            min: b.min.min(p),
-            max: b.max.max(p),
-        })
+        points.iter().fold(Aabb::EMPTY, |b, &p| Aabb { min: b.min.min(p), max: b.max.max(p) })
     }
 
     pub fn union(self, other: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
+        Aabb { min: self.min.min(other.min), max: self.max.max(other.max) }
     }
 
     #[inline]
@@ -80,24 +71,15 @@ impl Bvh {
     /// Builds the subtree over `items` (which start at `offset` in the final item list), splitting
     /// at the median centre along the axis where the centres spread most.
     fn build_node(&mut self, boxes: &[Aabb], items: &mut [u32], offset: usize) -> u32 {
-        let bounds = items
-            .iter()
-            .fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]));
+        let bounds = items.iter().fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]));
         let id = self.nodes.len() as u32;
-        self.nodes.push(Node {
-            bounds,
-            first_or_right: offset as u32,
-            count: items.len() as u32,
-        });
+        self.nodes.push(Node { bounds, first_or_right: offset as u32, count: items.len() as u32 });
         if items.len() <= LEAF_SIZE {
             return id;
         }
         let centers = items.iter().fold(Aabb::EMPTY, |b, &i| {
             let c = boxes[i as usize].center();
-            Aabb {
-                min: b.min.min(c),
-                max: b.max.max(c),
-            }
+            Aabb { min: b.min.min(c), max: b.max.max(c) }
         });
         let spread = centers.max - centers.min;
         let axis = if spread.x >= spread.y && spread.x >= spread.z {
@@ -201,10 +183,7 @@ mod tests {
                 let c = Vec3::new(next(), next(), next()) * 10.0;
                 let size = if i % 17 == 0 { 3.0 } else { 0.4 };
                 let h = Vec3::new(next(), next(), next()) * size;
-                Aabb {
-                    min: c - h,
-                    max: c + h,
-                }
+                Aabb { min: c - h, max: c + h }
             })
             .collect()
     }
@@ -230,10 +209,7 @@ mod tests {
             }
             assert_eq!(found, expected, "n = {n}");
             if n == 400 {
-                assert!(
-                    expected.len() > 100,
-                    "the test needs overlaps to mean anything"
-                );
+                assert!(expected.len() > 100, "the test needs overlaps to mean anything");
             }
         }
     }

@@ -14,11 +14,7 @@ use crate::grid::Grid;
 /// # Panics
 /// When `values` does not hold exactly one sample per grid point.
 pub fn digital_euler(values: &[f32], grid: &Grid, iso: f32) -> i64 {
-    assert_eq!(
-        values.len(),
-        grid.point_count(),
-        "digital_euler needs one value per grid point"
-    );
+    assert_eq!(values.len(), grid.point_count(), "digital_euler needs one value per grid point");
     let [nx, ny, nz] = grid.points();
     let inside: Vec<bool> = values.iter().map(|&v| v < iso).collect();
     let (sx, sy, sz) = (1, nx, nx * ny);

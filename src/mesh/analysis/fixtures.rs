@@ -17,12 +17,7 @@ pub fn mesh(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Mesh {
 /// The corner of the unit cube: volume 1/6, area 3/2 + sqrt(3)/2.
 pub fn tetrahedron() -> Mesh {
     mesh(
-        &[
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ],
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
     )
 }
@@ -44,11 +39,7 @@ pub fn octahedron() -> Mesh {
                 let (a, b, c) = (sx, 2 + sy, 4 + sz);
                 // The octant's sign product decides which winding faces away from the origin.
                 let negatives = sx + sy + sz;
-                triangles.push(if negatives % 2 == 0 {
-                    [a, b, c]
-                } else {
-                    [a, c, b]
-                });
+                triangles.push(if negatives % 2 == 0 { [a, b, c] } else { [a, c, b] });
             }
         }
     }
@@ -57,9 +48,8 @@ pub fn octahedron() -> Mesh {
 
 /// The unit cube `[0, 1]^3` as 12 triangles, vertex `i` at `(i & 1, (i >> 1) & 1, i >> 2)`.
 pub fn cube() -> Mesh {
-    let positions: Vec<[f32; 3]> = (0..8)
-        .map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32])
-        .collect();
+    let positions: Vec<[f32; 3]> =
+        (0..8).map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32]).collect();
     mesh(
         &positions,
         &[
@@ -93,18 +83,14 @@ pub fn merged(a: &Mesh, b: &Mesh) -> Mesh {
     let mut out = a.clone();
     out.positions.extend_from_slice(&b.positions);
     out.normals.extend_from_slice(&b.normals);
-    out.triangles
-        .extend(b.triangles.iter().map(|t| t.map(|v| v + shift)));
+    out.triangles.extend(b.triangles.iter().map(|t| t.map(|v| v + shift)));
     out
 }
 
 pub const SPHERE_RADIUS: f32 = 0.8;
 
 pub fn sphere_field() -> Sphere {
-    Sphere {
-        center: Vec3::new(0.013, -0.007, 0.021),
-        radius: SPHERE_RADIUS,
-    }
+    Sphere { center: Vec3::new(0.013, -0.007, 0.021), radius: SPHERE_RADIUS }
 }
 
 /// Marching Cubes of [`sphere_field`] with `res` cells across `[-1, 1]`; the centre is off the grid

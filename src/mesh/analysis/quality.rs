@@ -84,11 +84,7 @@ pub fn aspect_ratios(mesh: &Mesh) -> (f64, f64) {
         if double_area == 0.0 {
             continue;
         }
-        let lengths = [
-            (p[1] - p[0]).length(),
-            (p[2] - p[1]).length(),
-            (p[0] - p[2]).length(),
-        ];
+        let lengths = [(p[1] - p[0]).length(), (p[2] - p[1]).length(), (p[0] - p[2]).length()];
         let perimeter: f64 = lengths.iter().sum();
         let inradius = double_area / perimeter;
         let longest = lengths[0].max(lengths[1]).max(lengths[2]);
@@ -181,15 +177,9 @@ mod tests {
 
     #[test]
     fn degenerate_triangles_are_skipped_by_shape_statistics() {
-        let m = mesh(
-            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
-            &[[0, 1, 2], [0, 0, 1]],
-        );
+        let m = mesh(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2], [0, 0, 1]]);
         let a = angle_stats(&m);
-        assert_eq!(
-            a.measured_triangles, 1,
-            "the collinear one has angles 0, 0, 180"
-        );
+        assert_eq!(a.measured_triangles, 1, "the collinear one has angles 0, 0, 180");
         assert!(close(a.max_deg, 180.0, 1e-9) && a.min_deg == 0.0);
         assert_eq!(a.histogram_5deg[35], 1);
         assert_eq!(aspect_ratios(&m), (0.0, 0.0));
@@ -203,10 +193,7 @@ mod tests {
         let expected = 2f64.sqrt() / (3f64.sqrt() * (2.0 - 2f64.sqrt()));
         let (_, max) = aspect_ratios(&tetrahedron());
         assert!(close(max, expected, 1e-6), "{max} vs {expected}");
-        let needle = mesh(
-            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.01, 0.0]],
-            &[[0, 1, 2]],
-        );
+        let needle = mesh(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.01, 0.0]], &[[0, 1, 2]]);
         assert!(aspect_ratios(&needle).1 > 20.0);
     }
 
@@ -222,10 +209,7 @@ mod tests {
             let volume_err = (volume / (4.0 / 3.0 * PI * r * r * r) - 1.0).abs();
             assert!(area_err < 0.03, "res {res}: area {area}");
             assert!(volume_err < 0.03, "res {res}: volume {volume}");
-            assert!(
-                volume_err < previous_error,
-                "res {res}: volume error did not shrink"
-            );
+            assert!(volume_err < previous_error, "res {res}: volume error did not shrink");
             previous_error = volume_err;
             let angles = angle_stats(&m);
             assert_eq!(angles.measured_triangles, m.triangle_count());

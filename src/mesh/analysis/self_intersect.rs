@@ -30,10 +30,7 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
             a != b && b != c && a != c
         })
         .collect();
-    let boxes: Vec<Aabb> = ids
-        .iter()
-        .map(|&t| Aabb::of_points(&mesh.corners(t as usize)))
-        .collect();
+    let boxes: Vec<Aabb> = ids.iter().map(|&t| Aabb::of_points(&mesh.corners(t as usize))).collect();
     let bvh = Bvh::build(&boxes);
     let mut pairs = Vec::new();
     bvh.overlapping_pairs(&boxes, |i, j| {
@@ -100,24 +97,12 @@ mod tests {
     fn a_fold_at_a_shared_vertex_is_found() {
         // A fan of two triangles around vertex 0; the second is folded back over the first.
         let folded = mesh(
-            &[
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [1.0, 0.2, 0.0],
-                [0.2, 1.0, 0.0],
-            ],
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.2, 0.0], [0.2, 1.0, 0.0]],
             &[[0, 1, 2], [0, 4, 3]],
         );
         assert_eq!(self_intersecting_pairs(&folded), vec![[0, 1]]);
         let spread = mesh(
-            &[
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [-1.0, 0.0, 0.0],
-                [0.0, -1.0, 0.0],
-            ],
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]],
             &[[0, 1, 2], [0, 3, 4]],
         );
         assert_eq!(self_intersections(&spread), 0);
@@ -180,9 +165,7 @@ mod tests {
         let (mut m, _) = mc_sphere(16);
         let n = m.positions.len();
         // Drive one vertex through the sphere to the far side.
-        let v = (0..n)
-            .max_by(|&a, &b| m.positions[a].x.total_cmp(&m.positions[b].x))
-            .unwrap();
+        let v = (0..n).max_by(|&a, &b| m.positions[a].x.total_cmp(&m.positions[b].x)).unwrap();
         m.positions[v].x -= 1.7;
         assert!(self_intersections(&m) > 0);
     }

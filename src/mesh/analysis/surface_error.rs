@@ -46,12 +46,8 @@ const MAX_STEPS: usize = 8;
 /// of the normal statistics, as are faces where the gradient vanishes. An outward-facing mesh of a
 /// field that grows outward has deviations near 0; a flipped face shows up near 180 degrees.
 pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
-    let faces: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|&[a, b, c]| a != b && b != c && a != c)
-        .collect();
+    let faces: Vec<[u32; 3]> =
+        mesh.triangles.iter().copied().filter(|&[a, b, c]| a != b && b != c && a != c).collect();
     let mut referenced = vec![false; mesh.positions.len()];
     for &v in faces.iter().flatten() {
         referenced[v as usize] = true;
@@ -61,9 +57,7 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         .iter()
         .zip(&referenced)
         .filter(|(_, &r)| r)
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (&p, _)| {
-            (lo.min(p), hi.max(p))
-        });
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (&p, _)| (lo.min(p), hi.max(p)));
     if faces.is_empty() {
         return SurfaceError::default();
     }
@@ -96,9 +90,7 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         for corner in corners {
             record(&projector.project((centroid + corner) * 0.5));
         }
-        let normal = (corners[1] - corners[0])
-            .cross(corners[2] - corners[0])
-            .normalize_or_zero();
+        let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
         let gradient = projector.gradient(on_surface.point).normalize_or_zero();
         if normal != DVec3::ZERO && gradient != DVec3::ZERO {
             let angle = normal.cross(gradient).length().atan2(normal.dot(gradient));
@@ -171,11 +163,7 @@ impl Projector<'_> {
         }
         // A walk that is still taking small steps at the end has found the surface all the same.
         converged |= last_step <= 10.0 * self.tolerance;
-        Projection {
-            point: p,
-            distance: (p - start).length(),
-            converged,
-        }
+        Projection { point: p, distance: (p - start).length(), converged }
     }
 }
 
@@ -187,10 +175,7 @@ mod tests {
 
     #[test]
     fn an_octahedron_inscribed_in_the_unit_sphere() {
-        let sphere = Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-        };
+        let sphere = Sphere { center: Vec3::ZERO, radius: 1.0 };
         let e = surface_error(&octahedron(), &sphere);
         assert_eq!(e.samples, 6 + 4 * 8);
         assert_eq!(e.unconverged, 0);
@@ -204,20 +189,14 @@ mod tests {
 
     #[test]
     fn flipped_faces_deviate_by_half_a_turn() {
-        let sphere = Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-        };
+        let sphere = Sphere { center: Vec3::ZERO, radius: 1.0 };
         let mut m = octahedron();
         for t in &mut m.triangles[..4] {
             t.swap(1, 2);
         }
         let e = surface_error(&m, &sphere);
         assert!((e.normal_dev_deg_max - 180.0).abs() < 1e-3);
-        assert!(
-            e.normal_dev_deg_p50 < 1e-3,
-            "half the faces are still right"
-        );
+        assert!(e.normal_dev_deg_p50 < 1e-3, "half the faces are still right");
     }
 
     #[test]

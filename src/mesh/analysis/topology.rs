@@ -61,18 +61,8 @@ impl Topology {
 /// Indices beyond `positions` are tolerated (the analysis is combinatorial); only the
 /// degenerate-triangle count looks at positions.
 pub fn topology(mesh: &Mesh) -> Topology {
-    let faces: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|t| !is_collapsed(t))
-        .collect();
-    let vertex_slots = faces
-        .iter()
-        .flatten()
-        .map(|&v| v as usize + 1)
-        .max()
-        .unwrap_or(0);
+    let faces: Vec<[u32; 3]> = mesh.triangles.iter().copied().filter(|t| !is_collapsed(t)).collect();
+    let vertex_slots = faces.iter().flatten().map(|&v| v as usize + 1).max().unwrap_or(0);
 
     let mut referenced = vec![false; vertex_slots];
     let mut sets = UnionFind::new(vertex_slots);
@@ -114,12 +104,7 @@ pub fn topology(mesh: &Mesh) -> Topology {
         degenerate_triangles: degenerate_triangles(mesh),
         ..Topology::default()
     };
-    count_edges(
-        &faces,
-        &mut topo,
-        |v| component_of[v as usize] as usize,
-        &mut component_euler,
-    );
+    count_edges(&faces, &mut topo, |v| component_of[v as usize] as usize, &mut component_euler);
     topo.non_manifold_vertices = count_non_manifold_vertices(&faces, vertex_slots);
     topo.euler = topo.vertices as i64 - topo.edges as i64 + topo.faces as i64;
     if topo.is_closed_manifold() {
@@ -253,9 +238,7 @@ struct UnionFind {
 
 impl UnionFind {
     fn new(n: usize) -> Self {
-        UnionFind {
-            parent: (0..n as u32).collect(),
-        }
+        UnionFind { parent: (0..n as u32).collect() }
     }
 
     fn find(&mut self, mut x: u32) -> u32 {
@@ -375,10 +358,7 @@ mod tests {
 
     #[test]
     fn disjoint_solids_are_separate_components() {
-        let m = merged(
-            &cube(),
-            &translated(&octahedron(), Vec3::new(5.0, 0.0, 0.0)),
-        );
+        let m = merged(&cube(), &translated(&octahedron(), Vec3::new(5.0, 0.0, 0.0)));
         let t = topology(&m);
         assert!(t.is_closed_manifold());
         assert_eq!(t.components, 2);
@@ -397,10 +377,7 @@ mod tests {
         assert_eq!(degenerate_triangles(&m), 2);
         let t = topology(&m);
         assert_eq!(t.degenerate_triangles, 2);
-        assert_eq!(
-            t.faces, 9,
-            "the collinear triangle is a 2-cell, the collapsed one is not"
-        );
+        assert_eq!(t.faces, 9, "the collinear triangle is a 2-cell, the collapsed one is not");
     }
 
     #[test]
@@ -414,14 +391,9 @@ mod tests {
 
     #[test]
     fn mc_torus_has_genus_one_and_twice_the_digital_euler_number() {
-        let torus = crate::scenes::Torus {
-            major: 0.6,
-            minor: 0.25,
-        };
-        let grid =
-            crate::grid::Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), 40).unwrap();
-        let (m, _) =
-            crate::mc::mesh_field(&torus, &grid, &crate::mc::McOptions::default()).unwrap();
+        let torus = crate::scenes::Torus { major: 0.6, minor: 0.25 };
+        let grid = crate::grid::Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), 40).unwrap();
+        let (m, _) = crate::mc::mesh_field(&torus, &grid, &crate::mc::McOptions::default()).unwrap();
         let t = topology(&m);
         assert!(t.is_closed_manifold(), "{t:?}");
         assert_eq!(t.euler, 0);

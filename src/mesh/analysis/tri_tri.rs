@@ -80,19 +80,14 @@ pub fn overlap_beyond_shared_vertex(a: &[DVec3; 2], b: &[DVec3; 2]) -> bool {
         .contains(&true)
             || same_rays(a, b);
     }
-    [line, -line]
-        .iter()
-        .any(|&d| in_closed_wedge(a, na, d) && in_closed_wedge(b, nb, d))
+    [line, -line].iter().any(|&d| in_closed_wedge(a, na, d) && in_closed_wedge(b, nb, d))
 }
 
 /// Normalised sines of the angles from the first side ray to `x` and from `x` to the second, both
 /// measured around the wedge's normal `n = r[0] x r[1]`: both positive inside the wedge.
 fn wedge_sines(r: &[DVec3; 2], n: DVec3, x: DVec3) -> (f64, f64) {
     let nl = n.length() * x.length();
-    (
-        r[0].cross(x).dot(n) / (nl * r[0].length()),
-        x.cross(r[1]).dot(n) / (nl * r[1].length()),
-    )
+    (r[0].cross(x).dot(n) / (nl * r[0].length()), x.cross(r[1]).dot(n) / (nl * r[1].length()))
 }
 
 fn strictly_inside(r: &[DVec3; 2], n: DVec3, x: DVec3) -> bool {
@@ -153,10 +148,7 @@ mod tests {
         let across = t([[0.6, 0.6, 0.0], [2.0, 0.6, 0.0], [0.6, 2.0, 0.0]]);
         assert!(!triangles_intersect(&a, &across));
         let touching = t([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0]]);
-        assert!(
-            triangles_intersect(&a, &touching),
-            "closed triangles touching at a corner"
-        );
+        assert!(triangles_intersect(&a, &touching), "closed triangles touching at a corner");
     }
 
     #[test]
@@ -171,52 +163,28 @@ mod tests {
     #[test]
     fn coplanar_wedges_overlap_only_in_a_positive_angle() {
         let a = w([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
-        assert!(overlap_beyond_shared_vertex(
-            &a,
-            &w([[1.0, 1.0, 0.0], [-1.0, 2.0, 0.0]])
-        ));
+        assert!(overlap_beyond_shared_vertex(&a, &w([[1.0, 1.0, 0.0], [-1.0, 2.0, 0.0]])));
         assert!(
             overlap_beyond_shared_vertex(&a, &w([[0.0, 2.0, 0.0], [3.0, 0.0, 0.0]])),
             "same wedge, flipped"
         );
         // Fan neighbours two steps apart, and a wedge sharing only a side ray: no overlap.
-        assert!(!overlap_beyond_shared_vertex(
-            &a,
-            &w([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
-        ));
-        assert!(!overlap_beyond_shared_vertex(
-            &a,
-            &w([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
-        ));
+        assert!(!overlap_beyond_shared_vertex(&a, &w([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])));
+        assert!(!overlap_beyond_shared_vertex(&a, &w([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])));
     }
 
     #[test]
     fn tilted_wedges_overlap_when_their_common_line_runs_through_both() {
         let a = w([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
         // Contains the direction (1, 1, 0), which lies inside `a`.
-        assert!(overlap_beyond_shared_vertex(
-            &a,
-            &w([[0.5, 0.5, 1.0], [0.5, 0.5, -1.0]])
-        ));
+        assert!(overlap_beyond_shared_vertex(&a, &w([[0.5, 0.5, 1.0], [0.5, 0.5, -1.0]])));
         // Contains only (-1, -1, 0): the planes meet in a line that leaves `a` on the other side.
-        assert!(!overlap_beyond_shared_vertex(
-            &a,
-            &w([[-0.5, -0.5, 1.0], [-0.5, -0.5, -1.0]])
-        ));
+        assert!(!overlap_beyond_shared_vertex(&a, &w([[-0.5, -0.5, 1.0], [-0.5, -0.5, -1.0]])));
         // A steep neighbour on a cone around the apex.
-        assert!(!overlap_beyond_shared_vertex(
-            &a,
-            &w([[-1.0, 0.0, 0.3], [0.0, -1.0, 0.3]])
-        ));
+        assert!(!overlap_beyond_shared_vertex(&a, &w([[-1.0, 0.0, 0.3], [0.0, -1.0, 0.3]])));
         // An edge of `b` lying in `a`: the fold touches along a segment.
-        assert!(overlap_beyond_shared_vertex(
-            &a,
-            &w([[1.0, 1.0, 0.0], [1.0, 1.0, 1.0]])
-        ));
+        assert!(overlap_beyond_shared_vertex(&a, &w([[1.0, 1.0, 0.0], [1.0, 1.0, 1.0]])));
         // Degenerate wedge.
-        assert!(!overlap_beyond_shared_vertex(
-            &a,
-            &w([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]])
-        ));
+        assert!(!overlap_beyond_shared_vertex(&a, &w([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]])));
     }
 }
