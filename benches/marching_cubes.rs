@@ -40,9 +40,7 @@
 //! 4 s for `isosurface` and simply takes longer.
 
 use criterion::measurement::WallTime;
-use criterion::{
-    criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
-};
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use fast_surface_nets::ndshape::RuntimeShape;
 use fast_surface_nets::{surface_nets, SurfaceNetsBuffer};
 use isoforge::field::sample_grid;
@@ -73,11 +71,7 @@ impl ScalarSource for NearestSample<'_> {
     fn sample_scalar(&self, p: UnitVec3) -> Signed {
         let c = self.grid.cells;
         let nearest = |u: f32, a: usize| ((u * c[a] as f32).round().max(0.0) as usize).min(c[a]);
-        Signed(
-            self.values[self
-                .grid
-                .index(nearest(p.x, 0), nearest(p.y, 1), nearest(p.z, 2))],
-        )
+        Signed(self.values[self.grid.index(nearest(p.x, 0), nearest(p.y, 1), nearest(p.z, 2))])
     }
 }
 
@@ -85,11 +79,7 @@ fn isoforge_mc(values: &[f32], grid: &Grid) -> isoforge::Mesh {
     mc::extract(values, grid, &McOptions::default()).expect("isoforge extraction")
 }
 
-fn fast_surface_nets(
-    values: &[f32],
-    shape: &RuntimeShape<u32, 3>,
-    grid: &Grid,
-) -> SurfaceNetsBuffer {
+fn fast_surface_nets(values: &[f32], shape: &RuntimeShape<u32, 3>, grid: &Grid) -> SurfaceNetsBuffer {
     let max = grid.cells.map(|c| c as u32);
     let mut buffer = SurfaceNetsBuffer::default();
     surface_nets(values, shape, [0; 3], max, &mut buffer);
@@ -102,10 +92,7 @@ fn isosurface_mc(source: &NearestSample) -> (Vec<f32>, Vec<u32>) {
     let mut indices = Vec::new();
     let sampler = Sampler::new(source);
     let mut mc = MarchingCubes::<Signed>::new(source.grid.cells[0] + 1);
-    mc.extract(
-        &sampler,
-        &mut IndexedVertices::new(&mut vertices, &mut indices),
-    );
+    mc.extract(&sampler, &mut IndexedVertices::new(&mut vertices, &mut indices));
     (vertices, indices)
 }
 
@@ -121,18 +108,12 @@ fn configure(group: &mut BenchmarkGroup<WallTime>, res: usize) {
 
 fn bench_scene(c: &mut Criterion, scene: &Scene, res: usize) {
     let grid = Grid::with_resolution(scene.min, scene.max, res).expect("grid");
-    assert_eq!(
-        grid.cells, [res; 3],
-        "the peers need a cubic grid; scene bounds must be a cube"
-    );
+    assert_eq!(grid.cells, [res; 3], "the peers need a cubic grid; scene bounds must be a cube");
     let field = scene.field.as_ref();
     let values = sample_grid(field, &grid).expect("sampling");
     let cells = grid.cell_count();
     let shape = RuntimeShape::<u32, 3>::new(grid.points().map(|p| p as u32));
-    let source = NearestSample {
-        values: &values,
-        grid,
-    };
+    let source = NearestSample { values: &values, grid };
 
     // Output sizes, once per scene and size, so triangles/s can be derived from the times.
     let ours = isoforge_mc(&values, &grid);
@@ -164,9 +145,7 @@ fn bench_scene(c: &mut Criterion, scene: &Scene, res: usize) {
     configure(&mut group, res);
     group.throughput(Throughput::Elements(cells));
     group.bench_function("isoforge_mc", |b| b.iter(|| isoforge_mc(&values, &grid)));
-    group.bench_function("fast_surface_nets", |b| {
-        b.iter(|| fast_surface_nets(&values, &shape, &grid))
-    });
+    group.bench_function("fast_surface_nets", |b| b.iter(|| fast_surface_nets(&values, &shape, &grid)));
     group.bench_function("isosurface_mc", |b| b.iter(|| isosurface_mc(&source)));
     group.finish();
 }
