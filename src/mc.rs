@@ -185,7 +185,9 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
     let mut mesh = Mesh::default();
     let mut cache = EdgeCache::new(nx, ny);
     let fixed = triangle_table();
-    let with_faces = triangle_table_with_faces();
+    // The 16 384-entry table is built only when the trilinear option asks for it.
+    let with_faces: &[CellTriangles] =
+        if options.topology == Topology::Trilinear { triangle_table_with_faces() } else { &[] };
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
 
     for k in 0..cz {

@@ -182,7 +182,10 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
     let mut out = EmcMesh::default();
     let mut cache = EdgeCache::new(nx, ny);
     let (fixed, fixed_tris) = (polygon_table(), triangle_table());
-    let (with_faces, with_faces_tris) = (polygon_table_with_faces(), triangle_table_with_faces());
+    let (with_faces, with_faces_tris): (&[CellPolygons], &[CellTriangles]) = match options.topology {
+        Topology::Trilinear => (polygon_table_with_faces(), triangle_table_with_faces()),
+        Topology::Fixed => (&[], &[]),
+    };
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
 
