@@ -1,6 +1,7 @@
 //! From a request (method, resolution, options) to a mesh and its stats: the one path the CLI, the
 //! wasm bindings and the benches share, so the three can never disagree about what a request means.
 
+use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
 use crate::field::{Field, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
@@ -14,14 +15,16 @@ use glam::Vec3;
 pub enum Method {
     #[default]
     Mc,
+    Emc,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 1] = ["mc"];
+    pub const NAMES: [&'static str; 2] = ["mc", "emc"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
             "mc" => Ok(Method::Mc),
+            "emc" => Ok(Method::Emc),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -33,6 +36,7 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Mc => "mc",
+            Method::Emc => "emc",
         }
     }
 }
@@ -49,6 +53,12 @@ pub struct Request {
     /// Overrides the input's own bounds.
     pub bounds: Option<(Vec3, Vec3)>,
     pub analysis: AnalysisOptions,
+    /// EMC: sharp when the normal cone's min nᵢ·nⱼ is below this.
+    pub theta_sharp: f32,
+    /// EMC: corner when max |nᵢ·n*| exceeds this.
+    pub phi_corner: f32,
+    /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
+    pub directed: bool,
 }
 
 impl Default for Request {
@@ -61,6 +71,9 @@ impl Default for Request {
             max_cells: DEFAULT_MAX_CELLS,
             bounds: None,
             analysis: AnalysisOptions::default(),
+            theta_sharp: 0.9,
+            phi_corner: 0.7,
+            directed: true,
         }
     }
 }
@@ -69,44 +82,78 @@ impl Request {
     fn mc_options(&self) -> McOptions {
         McOptions { iso: self.iso, topology: self.topology, max_cells: self.max_cells }
     }
+
+    fn emc_options(&self) -> EmcOptions {
+        EmcOptions {
+            iso: self.iso,
+            theta_sharp: self.theta_sharp,
+            phi_corner: self.phi_corner,
+            directed: self.directed,
+            flip_edges: true,
+            topology: self.topology,
+            max_cells: self.max_cells,
+        }
+    }
+}
+
+/// A mesh plus what the method knows about its features (empty for methods that know none).
+#[derive(Debug, Clone, Default)]
+pub struct Output {
+    pub mesh: Mesh,
+    /// Feature lines as vertex index pairs.
+    pub feature_edges: Vec<[u32; 2]>,
+    pub stats: Stats,
+}
+
+fn from_emc(
+    out: EmcMesh,
+    timings: crate::emc::EmcTimings,
+) -> (Mesh, Vec<[u32; 2]>, Vec<(String, f64)>, [usize; 3]) {
+    let counts = [out.edge_features, out.corner_features, out.flips];
+    (out.mesh, out.feature_edges, timings.phases(), counts)
 }
 
 /// Meshes a field over `bounds` (unless the request overrides them).
-pub fn mesh_field(
-    field: &dyn Field,
-    bounds: (Vec3, Vec3),
-    request: &Request,
-) -> Result<(Mesh, Stats), Error> {
+pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error> {
     let (min, max) = request.bounds.unwrap_or(bounds);
     let grid = Grid::with_resolution(min, max, request.res)?;
     grid.check_size(request.max_cells)?;
-    let (mesh, timings) = match request.method {
-        Method::Mc => mc::mesh_field(field, &grid, &request.mc_options())?,
+    let (mesh, feature_edges, phases, counts) = match request.method {
+        Method::Mc => {
+            let (mesh, timings) = mc::mesh_field(field, &grid, &request.mc_options())?;
+            (mesh, vec![], timings.phases(), [0; 3])
+        }
+        Method::Emc => {
+            let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
+            from_emc(out, timings)
+        }
     };
     let shifted = Shifted { field, iso: request.iso };
-    let stats = stats::compute(
-        request.method.name(),
-        request.res,
-        &mesh,
-        &shifted,
-        timings.phases(),
-        request.analysis,
-    );
-    Ok((mesh, stats))
+    let mut stats =
+        stats::compute(request.method.name(), request.res, &mesh, &shifted, phases, request.analysis);
+    stats.set_feature_counts(feature_edges.len(), counts);
+    Ok(Output { mesh, feature_edges, stats })
 }
 
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
 /// the samples stands in for the true surface in the error statistics.
-pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<(Mesh, Stats), Error> {
-    let (mesh, timings) = match request.method {
-        Method::Mc => mc::mesh_samples(values, grid, &request.mc_options())?,
+pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Output, Error> {
+    let (mesh, feature_edges, phases, counts) = match request.method {
+        Method::Mc => {
+            let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
+            (mesh, vec![], timings.phases(), [0; 3])
+        }
+        Method::Emc => {
+            let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
+            from_emc(out, timings)
+        }
     };
     let field = SampledField { grid: *grid, values };
     let shifted = Shifted { field: &field, iso: request.iso };
     let res = grid.cells.iter().copied().max().unwrap_or(0);
-    let stats =
-        stats::compute(request.method.name(), res, &mesh, &shifted, timings.phases(), request.analysis);
-    Ok((mesh, stats))
+    let mut stats = stats::compute(request.method.name(), res, &mesh, &shifted, phases, request.analysis);
+    stats.set_feature_counts(feature_edges.len(), counts);
+    Ok(Output { mesh, feature_edges, stats })
 }
 
 /// The field minus the iso-level, so "the surface" is always the zero set for the analysis.

@@ -22,7 +22,7 @@ impl Default for AnalysisOptions {
     }
 }
 
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq, Default)]
 pub struct Stats {
     pub method: String,
     /// Cells along the longest side of the bounds (or of the finest octree level).
@@ -59,6 +59,22 @@ pub struct Stats {
     #[serde(serialize_with = "phases_as_object")]
     pub phases_ms: Vec<(String, f64)>,
     pub ms_analysis: f64,
+    /// Mesh edges on reconstructed feature lines (EMC), 0 for methods without feature detection.
+    pub feature_edges: usize,
+    /// Cells whose component was classified as an edge / a corner feature (EMC).
+    pub edge_features: usize,
+    pub corner_features: usize,
+    /// Edges flipped to make feature lines explicit (EMC).
+    pub flips: usize,
+}
+
+impl Stats {
+    pub(crate) fn set_feature_counts(&mut self, feature_edges: usize, [edges, corners, flips]: [usize; 3]) {
+        self.feature_edges = feature_edges;
+        self.edge_features = edges;
+        self.corner_features = corners;
+        self.flips = flips;
+    }
 }
 
 /// Analyses `mesh` against `field` (its true surface) and bundles the numbers with the timings.
@@ -108,6 +124,7 @@ pub fn compute(
         ms_total,
         phases_ms,
         ms_analysis: crate::mc::ms_since(t0),
+        ..Stats::default()
     }
 }
 

@@ -29,7 +29,7 @@ struct MeshArgs {
     /// A built-in scene (see `isoforge scenes`).
     #[arg(long)]
     scene: String,
-    /// Meshing method.
+    /// Meshing method: mc (Marching Cubes) or emc (Extended Marching Cubes).
     #[arg(long, default_value = "mc")]
     method: String,
     /// Cells along the longest side of the bounds.
@@ -56,6 +56,15 @@ struct MeshArgs {
     /// Skip the pairwise self-intersection check in --stats (the costliest one).
     #[arg(long)]
     no_intersections: bool,
+    /// EMC: a cell is sharp when the min dot product of its normals is below this.
+    #[arg(long, default_value_t = 0.9, allow_hyphen_values = true)]
+    theta_sharp: f32,
+    /// EMC: a sharp cell holds a corner when max |n·n*| exceeds this.
+    #[arg(long, default_value_t = 0.7, allow_hyphen_values = true)]
+    phi_corner: f32,
+    /// EMC: place edge crossings by linear interpolation instead of exact root finding.
+    #[arg(long)]
+    no_directed: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -96,14 +105,17 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         max_cells: args.max_cells,
         bounds: args.bounds.map(|b| (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]))),
         analysis: AnalysisOptions { self_intersections: !args.no_intersections, surface_error: true },
+        theta_sharp: args.theta_sharp,
+        phi_corner: args.phi_corner,
+        directed: !args.no_directed,
     };
     let scene = scenes::scene(&args.scene)?;
-    let (mesh, stats) = pipeline::mesh_field(scene.field.as_ref(), (scene.min, scene.max), &request)?;
+    let out = pipeline::mesh_field(scene.field.as_ref(), (scene.min, scene.max), &request)?;
     if let Some(path) = &args.output {
-        export::write_by_extension(&mesh, path)?;
+        export::write_by_extension(&out.mesh, path)?;
     }
     if args.stats {
-        println!("{}", serde_json::to_string(&stats).map_err(|e| Error::Io(e.to_string()))?);
+        println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Io(e.to_string()))?);
     }
     Ok(())
 }

@@ -38,7 +38,7 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
         let old = normal(p(a), p(b), p(c)) + normal(p(b), p(a), p(d));
         let new1 = normal(p(c), p(a), p(d));
         let new2 = normal(p(d), p(b), p(c));
-        if new1.dot(old) <= 0.0 || new2.dot(old) <= 0.0 || new1.dot(new2) <= 0.0 {
+        if new1.dot(old) <= 0.0 || new2.dot(old) <= 0.0 {
             continue;
         }
         mesh.triangles[t1 as usize] = [c, a, d];
