@@ -34,7 +34,7 @@ impl Node {
 
 /// Upper bound on nodes. Transforms copy their operand's subgraph, so a few lines that keep
 /// transforming bindings of bindings can ask for exponentially many nodes; this stops them.
-pub const MAX_NODES: usize = 1 << 20;
+pub const MAX_NODES: usize = 1 << 18;
 
 #[derive(Default)]
 pub struct Graph {

@@ -280,3 +280,159 @@ pub fn eval_interval_with_choices(tape: &Tape, lo: Vec3, hi: Vec3) -> (Interval,
     });
     (r, choices)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::compile;
+    use super::super::testutil::{Rng, CASES};
+    use super::*;
+
+    /// A random box: anywhere in the test cube, from tiny to most of the cube.
+    fn random_box(rng: &mut Rng) -> (Vec3, Vec3) {
+        let c = rng.vec3(-1.5, 1.5);
+        let h = Vec3::new(rng.range(-3.0, 0.0), rng.range(-3.0, 0.0), rng.range(-3.0, 0.0)).map(|e| 10f32.powf(e));
+        (c - h, c + h)
+    }
+
+    fn sample(rng: &mut Rng, lo: Vec3, hi: Vec3) -> Vec3 {
+        lo + (hi - lo) * Vec3::new(rng.range(0.0, 1.0), rng.range(0.0, 1.0), rng.range(0.0, 1.0))
+    }
+
+    #[test]
+    fn bounds_contain_every_sampled_value_for_every_case() {
+        let mut rng = Rng::new(10);
+        for case in CASES {
+            let program = compile(case).unwrap();
+            let mut finite = 0;
+            for _ in 0..60 {
+                let (lo, hi) = random_box(&mut rng);
+                let (a, b) = program.eval_interval(lo, hi);
+                assert!(a <= b, "{case}: empty bounds [{a}, {b}]");
+                finite += usize::from(a.is_finite() && b.is_finite());
+                let corners = (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo));
+                let inside: Vec<Vec3> = (0..40).map(|_| sample(&mut rng, lo, hi)).collect();
+                for p in corners.chain(inside) {
+                    let v = program.eval(p);
+                    assert!(v.is_nan() || (a <= v && v <= b), "{case}: {v} at {p} outside [{a}, {b}] for box {lo}..{hi}");
+                }
+            }
+            assert!(finite > 20, "{case}: bounds were almost always infinite, which proves nothing");
+        }
+    }
+
+    #[test]
+    fn every_operation_bounds_its_values_on_random_intervals() {
+        let unary = [
+            UnaryOp::Neg,
+            UnaryOp::Abs,
+            UnaryOp::Sqrt,
+            UnaryOp::Sin,
+            UnaryOp::Cos,
+            UnaryOp::Tan,
+            UnaryOp::Asin,
+            UnaryOp::Acos,
+            UnaryOp::Atan,
+            UnaryOp::Exp,
+            UnaryOp::Ln,
+            UnaryOp::Floor,
+            UnaryOp::Sign,
+            UnaryOp::Powi(2),
+            UnaryOp::Powi(3),
+            UnaryOp::Powi(-2),
+            UnaryOp::Powi(-3),
+        ];
+        let binary = [
+            BinaryOp::Add,
+            BinaryOp::Sub,
+            BinaryOp::Mul,
+            BinaryOp::Div,
+            BinaryOp::Min,
+            BinaryOp::Max,
+            BinaryOp::Pow,
+            BinaryOp::Atan2,
+        ];
+        let mut rng = Rng::new(11);
+        let mut interval = |rng: &mut Rng| {
+            let c = rng.range(-20.0, 20.0) * if rng.below(2) == 0 { 1.0 } else { 0.05 };
+            let w = 10f32.powf(rng.range(-4.0, 1.0));
+            if rng.below(8) == 0 {
+                Interval::point(c)
+            } else {
+                Interval::new(c - w, c + w)
+            }
+        };
+        let mut inside = |rng: &mut Rng, i: Interval| i.lo + (i.hi - i.lo) * rng.range(0.0, 1.0);
+        for _ in 0..3000 {
+            let (a, b) = (interval(&mut rng), interval(&mut rng));
+            for op in unary {
+                let r = Interval::unary(op, a);
+                for _ in 0..20 {
+                    let x = inside(&mut rng, a);
+                    let v = ops::unary(op, x);
+                    assert!(v.is_nan() || r.contains(v), "{op}({x}) = {v} outside {r:?} for {a:?}");
+                }
+            }
+            for op in binary {
+                let r = Interval::binary(op, a, b);
+                for _ in 0..20 {
+                    let (x, y) = (inside(&mut rng, a), inside(&mut rng, b));
+                    let v = ops::binary(op, x, y);
+                    assert!(v.is_nan() || r.contains(v), "{}({x}, {y}) = {v} outside {r:?} for {a:?}, {b:?}", op.name());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn special_cases_are_tight_where_they_can_be() {
+        let i = Interval::new;
+        let u = Interval::unary;
+        let pi = std::f32::consts::PI;
+        assert_eq!(u(UnaryOp::Sqrt, i(-1.0, 4.0)), i(0.0, 2.0), "the undefined part is dropped");
+        assert_eq!(Interval::binary(BinaryOp::Div, i(1.0, 2.0), i(-1.0, 1.0)), Interval::EVERYTHING);
+        assert_eq!(u(UnaryOp::Powi(2), i(-3.0, 2.0)), i(0.0, 9.0));
+        assert_eq!(u(UnaryOp::Tan, i(1.0, 2.0)), Interval::EVERYTHING, "a pole at π/2");
+        let s = u(UnaryOp::Sin, i(0.1, 0.2));
+        assert!(s.lo > 0.09 && s.hi < 0.2, "no extremum inside: {s:?}");
+        // A maximum of sin far out, at π/2 + 20π.
+        let far = 0.5 * pi + 20.0 * pi;
+        assert_eq!(u(UnaryOp::Sin, i(far - 0.1, far + 0.1)).hi, 1.0);
+        assert!(u(UnaryOp::Sin, i(far - 0.1, far + 0.1)).lo > 0.99);
+        assert_eq!(u(UnaryOp::Cos, i(pi - 0.1, pi + 0.1)).lo, -1.0);
+        assert!(u(UnaryOp::Cos, i(-0.1, 0.1)).lo > 0.99);
+        assert_eq!(u(UnaryOp::Cos, i(0.0, 7.0)), i(-1.0, 1.0));
+        assert_eq!(u(UnaryOp::Ln, i(-1.0, 0.0)).hi, f32::NEG_INFINITY);
+        assert_eq!(Interval::binary(BinaryOp::Sub, i(f32::NEG_INFINITY, 0.0), i(f32::NEG_INFINITY, 0.0)).hi, f32::INFINITY);
+    }
+
+    #[test]
+    fn choices_name_the_branch_that_wins_and_simplify_keeps_values() {
+        let program = compile("union(translate(sphere(0.5), -1, 0, 0), translate(box(0.4, 0.4, 0.4), 1, 0, 0))").unwrap();
+        assert_eq!(program.choice_count(), 7, "{program}"); // the union and six in the box
+        let near_sphere = (Vec3::new(-1.2, -0.2, -0.2), Vec3::new(-0.8, 0.2, 0.2));
+        let (_, choices) = program.eval_interval_with_choices(near_sphere.0, near_sphere.1);
+        let union_choice = *choices.last().unwrap();
+        assert_eq!(union_choice, Choice::Left);
+        let lean = program.simplify(&choices);
+        assert!(lean.instruction_count() < program.instruction_count() / 2, "{lean}");
+        let (_, choices) = program.eval_interval_with_choices(Vec3::splat(-2.0), Vec3::splat(2.0));
+        assert_eq!(*choices.last().unwrap(), Choice::Both);
+
+        let mut rng = Rng::new(12);
+        for case in CASES {
+            let program = compile(case).unwrap();
+            for _ in 0..30 {
+                let (lo, hi) = random_box(&mut rng);
+                let (_, choices) = program.eval_interval_with_choices(lo, hi);
+                assert_eq!(choices.len(), program.choice_count());
+                let lean = program.simplify(&choices);
+                assert!(lean.instruction_count() <= program.instruction_count());
+                for _ in 0..20 {
+                    let p = sample(&mut rng, lo, hi);
+                    let (a, b) = (program.eval(p), lean.eval(p));
+                    assert!(a == b || (a.is_nan() && b.is_nan()), "{case} at {p}: {a} vs simplified {b}");
+                }
+            }
+        }
+    }
+}

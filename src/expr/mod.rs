@@ -92,3 +92,64 @@ pub fn compile(text: &str) -> Result<Program, Error> {
 pub fn parse(text: &str) -> Result<Script, Error> {
     parser::parse(text).map_err(|d| d.into_error(text))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::testutil::{Rng, CASES};
+    use super::*;
+    use glam::Vec3;
+
+    /// Whatever compiles must also evaluate in every mode without panicking.
+    fn exercise(text: &str) {
+        if let Ok(p) = compile(text) {
+            let q = Vec3::new(0.3, -0.2, 0.7);
+            let _ = (p.eval(q), p.eval_grad(q), p.eval_interval(-q, q));
+            let (_, choices) = p.eval_interval_with_choices(Vec3::splat(-1.0), Vec3::ONE);
+            let _ = p.simplify(&choices).eval(q);
+            let mut out = [0.0; 3];
+            p.eval_many(&[q, -q, q * 2.0], &mut out);
+            let _ = p.to_string();
+        } else if let Err(e) = compile(text) {
+            let _ = e.to_string();
+        }
+    }
+
+    #[test]
+    fn no_input_makes_it_panic() {
+        let mut rng = Rng::new(30);
+        let alphabet: Vec<char> = "xyz0123456789.eE+-*/^(),;=#\n\t /*abcdefghijklmnopqrstuvw_é$[]{}".chars().collect();
+        for _ in 0..3000 {
+            let len = rng.below(40);
+            let text: String = (0..len).map(|_| alphabet[rng.below(alphabet.len())]).collect();
+            exercise(&text);
+            let bytes: Vec<u8> = (0..len).map(|_| rng.next_u64() as u8).collect();
+            exercise(&String::from_utf8_lossy(&bytes));
+        }
+        for case in CASES {
+            for cut in 0..=case.len() {
+                if case.is_char_boundary(cut) {
+                    exercise(&case[..cut]);
+                }
+            }
+            // Point mutations: a token dropped or swapped often still parses, with odd arities.
+            let chars: Vec<char> = case.chars().collect();
+            for _ in 0..100 {
+                let mut m = chars.clone();
+                let i = rng.below(m.len());
+                if rng.below(2) == 0 {
+                    m.remove(i);
+                } else {
+                    m[i] = alphabet[rng.below(alphabet.len())];
+                }
+                exercise(&m.into_iter().collect::<String>());
+            }
+        }
+    }
+
+    #[test]
+    fn the_module_example_holds() {
+        let p = compile("body = rounded_box(1, 0.6, 0.4, 0.1);\nsubtract(body, translate(cylinder(0.25, 2), 0.3, 0, 0))").unwrap();
+        assert!(p.eval(Vec3::new(-0.6, 0.0, 0.0)) < 0.0);
+        assert!(p.eval(Vec3::new(0.3, 0.0, 0.0)) > 0.0, "in the hole");
+    }
+}

@@ -28,13 +28,16 @@ impl Emit for Numbers {
 }
 
 impl Backend for Numbers {
-    fn binding(&mut self, script: &Script, index: usize, at: [f32; 3]) -> Result<f32, Diag> {
-        lower(self, script, &script.bindings[index].value, at)
+    fn binding(&mut self, script: &Script, index: usize, at: [f32; 3], depth: usize) -> Result<f32, Diag> {
+        // Re-reading the binding's tree counts as going deeper, so a hand-built self-reference
+        // ends in an error instead of a stack overflow.
+        let binding = script.bindings.get(index).ok_or_else(|| Diag::new(Default::default(), "no such binding"))?;
+        lower(self, script, &binding.value, at, depth + 1)
     }
 }
 
 /// The value of `script` at `p` by walking the tree; NaN where the compiler would have refused the
 /// program (a zero rotation axis, say). Exponential in the depth of bindings-of-bindings.
 pub fn eval_tree(script: &Script, p: Vec3) -> f32 {
-    lower(&mut Numbers, script, &script.body, p.to_array()).unwrap_or(f32::NAN)
+    lower(&mut Numbers, script, &script.body, p.to_array(), 0).unwrap_or(f32::NAN)
 }

@@ -283,3 +283,90 @@ enum Level {
     Sum,
     Product,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::compile;
+    use crate::error::Error;
+    use glam::Vec3;
+
+    fn value(src: &str, p: Vec3) -> f32 {
+        compile(src).unwrap_or_else(|e| panic!("{src}: {e}")).eval(p)
+    }
+
+    #[test]
+    fn precedence_and_associativity() {
+        let p = Vec3::new(3.0, 2.0, 0.5);
+        let cases = [
+            ("-x^2", -9.0),
+            ("(-x)^2", 9.0),
+            ("-2^2", -4.0),
+            ("2^3^2", 512.0),
+            ("2^-1", 0.5),
+            ("x^-y", 1.0 / 9.0),
+            ("1 - 2 - 3", -4.0),
+            ("8 / 2 / 2", 2.0),
+            ("2 * -3", -6.0),
+            ("1 + 2 * 3 ^ 2", 19.0),
+            ("- -x", 3.0),
+            ("+x - +y", 1.0),
+            ("x * y / z", 12.0),
+            ("1e-3 * 1e3 + .5 + 2.", 3.5),
+        ];
+        for (src, want) in cases {
+            assert_eq!(value(src, p), want, "{src}");
+        }
+    }
+
+    #[test]
+    fn bindings_comments_and_an_optional_final_semicolon() {
+        let src = "# a comment\nr = 0.5; // another\n/* block\n comment */ d = r * 2;\nx - d;";
+        assert_eq!(value(src, Vec3::new(3.0, 0.0, 0.0)), 2.0);
+    }
+
+    fn error_at(src: &str) -> (usize, usize, String, String) {
+        match compile(src) {
+            Err(Error::Parse { message, line, column, snippet }) => (line, column, message, snippet),
+            other => panic!("{src}: expected a parse error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn errors_point_at_the_right_line_and_column() {
+        let cases: &[(&str, usize, usize, &str)] = &[
+            ("", 1, 1, "empty"),
+            ("sphere(1", 1, 1, "never closed"),
+            ("(x + 1", 1, 1, "'(' is never closed"),
+            ("x +", 1, 4, "expected an expression, found the end of the input"),
+            ("x + * 2", 1, 5, "expected an expression, found '*'"),
+            ("sphre(1)", 1, 1, "unknown function 'sphre'; did you mean 'sphere'?"),
+            ("sphere(1, 2)", 1, 1, "'sphere' takes 1 argument (sphere(r)), but was given 2"),
+            ("box(1)", 1, 1, "'box' takes 3 arguments (box(hx, hy, hz)), but was given 1"),
+            ("min()", 1, 1, "'min' takes at least 1 argument"),
+            ("x + foo", 1, 5, "unknown identifier 'foo'"),
+            ("r = 1;\nsphere(q)", 2, 8, "unknown identifier 'q'"),
+            ("a = 1;\nb = 2\nc = 3;\na", 2, 6, "expected ';' after the binding of 'b'"),
+            ("r = 1;\n\n   sphere(r) + sin", 3, 16, "'sin' is a function"),
+            ("x = 1; x", 1, 1, "cannot bind 'x'"),
+            ("a = 1;", 1, 7, "expected a final expression"),
+            ("sphere(1) sphere(2)", 1, 11, "expected an operator or the end of the program, found 'sphere'"),
+            ("y(2)", 1, 1, "'y' is a coordinate"),
+            ("a = 2; a(1)", 1, 8, "'a' is a binding, not a function"),
+            ("translate(sphere(1), 1, 2,)", 1, 27, "expected an expression, found ')'"),
+            ("// only\n/* comments */\n\t2x", 3, 2, "malformed number '2x'"),
+            ("a = 1;\n/* never\nclosed", 2, 1, "never closed"),
+            ("union(sphere(1)\n, box(1, 1, 1) $)", 2, 16, "unexpected character '$'"),
+        ];
+        for &(src, line, column, words) in cases {
+            let (l, c, message, _) = error_at(src);
+            assert_eq!((l, c), (line, column), "{src:?}: {message}");
+            assert!(message.contains(words), "{src:?}: {message}");
+        }
+    }
+
+    #[test]
+    fn error_display_quotes_the_line_with_a_caret() {
+        let err = compile("r = 0.5;\nsphere(r) + boxx(1, 1, 1)").unwrap_err().to_string();
+        assert_eq!(err, "2:13: unknown function 'boxx'; did you mean 'box'?\nsphere(r) + boxx(1, 1, 1)\n            ^");
+    }
+}
