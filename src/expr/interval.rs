@@ -352,7 +352,7 @@ mod tests {
             BinaryOp::Atan2,
         ];
         let mut rng = Rng::new(11);
-        let mut interval = |rng: &mut Rng| {
+        let interval = |rng: &mut Rng| {
             let c = rng.range(-20.0, 20.0) * if rng.below(2) == 0 { 1.0 } else { 0.05 };
             let w = 10f32.powf(rng.range(-4.0, 1.0));
             if rng.below(8) == 0 {
@@ -361,7 +361,7 @@ mod tests {
                 Interval::new(c - w, c + w)
             }
         };
-        let mut inside = |rng: &mut Rng, i: Interval| i.lo + (i.hi - i.lo) * rng.range(0.0, 1.0);
+        let inside = |rng: &mut Rng, i: Interval| i.lo + (i.hi - i.lo) * rng.range(0.0, 1.0);
         for _ in 0..3000 {
             let (a, b) = (interval(&mut rng), interval(&mut rng));
             for op in unary {

@@ -57,6 +57,7 @@ pub mod ast;
 mod builtins;
 mod compile;
 pub mod csg;
+mod csg_json;
 mod diag;
 mod eval;
 mod field;
@@ -76,7 +77,7 @@ mod testutil;
 pub use ast::Script;
 pub use builtins::{Arity, Builtin};
 pub use diag::Span;
-pub use csg::{CsgNode, MirrorAxis};
+pub use csg::CsgNode;
 pub use interval::Choice;
 pub use program::Program;
 

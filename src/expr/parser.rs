@@ -159,6 +159,10 @@ impl Parser {
                     return Ok(inner);
                 }
                 let span = t.span.to(inner.span);
+                // `-0.5` is one number, as it is in JSON: CSG trees and their text then match.
+                if let ExprKind::Number(v) = inner.kind {
+                    return Ok(Expr::new(ExprKind::Number(-v), span));
+                }
                 Ok(Expr::new(ExprKind::Neg(Box::new(inner)), span))
             }
             _ => self.power(),

@@ -108,10 +108,16 @@ pub trait Emit {
             if *c == 0.0 {
                 continue;
             }
-            let term = if *c == 1.0 { v } else { self.mul_c(v, *c as f32) };
-            acc = Some(match acc {
-                None => term,
-                Some(a) => self.add(a, term),
+            acc = Some(match (acc, *c) {
+                (None, 1.0) => v,
+                (None, -1.0) => self.neg(v),
+                (Some(a), 1.0) => self.add(a, v),
+                (Some(a), -1.0) => self.sub(a, v),
+                (None, c) => self.mul_c(v, c as f32),
+                (Some(a), c) => {
+                    let t = self.mul_c(v, c as f32);
+                    self.add(a, t)
+                }
             });
         }
         acc.unwrap_or_else(|| self.constant(0.0))
@@ -359,4 +365,144 @@ pub fn mirror<E: Emit>(e: &mut E, p: P<E>, axis: usize) -> P<E> {
 
 fn constants<E: Emit>(e: &E, v: &P<E>) -> Option<[f64; 3]> {
     Some([e.as_constant(v[0])? as f64, e.as_constant(v[1])? as f64, e.as_constant(v[2])? as f64])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::compile;
+    use super::super::testutil::Rng;
+    use super::rotation_matrix;
+    use glam::Vec3;
+
+    fn at(src: &str, p: [f32; 3]) -> f32 {
+        compile(src).unwrap_or_else(|e| panic!("{src}: {e}")).eval(Vec3::from_array(p))
+    }
+
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() < 1e-5
+    }
+
+    #[test]
+    fn sphere_is_distance_minus_radius() {
+        let p = compile("sphere(0.75)").unwrap();
+        let mut rng = Rng::new(40);
+        for _ in 0..200 {
+            let q = rng.vec3(-2.0, 2.0);
+            assert!(close(p.eval(q), q.length() - 0.75), "at {q}");
+        }
+    }
+
+    #[test]
+    fn box_distance_is_exact_at_known_points() {
+        let b = "box(0.5, 0.4, 0.3)";
+        assert!(close(at(b, [1.0, 0.0, 0.0]), 0.5), "face");
+        assert!(close(at(b, [1.0, 1.0, 0.0]), (0.5f32 * 0.5 + 0.6 * 0.6).sqrt()), "edge");
+        assert!(close(at(b, [1.5, -1.4, 1.3]), 3f32.sqrt()), "corner");
+        assert!(close(at(b, [0.0, 0.0, 0.0]), -0.3), "centre: nearest face is z");
+        assert!(close(at(b, [0.45, 0.0, 0.0]), -0.05));
+        let r = "rounded_box(0.5, 0.4, 0.3, 0.1)";
+        assert!(close(at(r, [1.0, 0.0, 0.0]), 0.5), "same outer size as the box");
+        let corner = Vec3::new(0.4, 0.3, 0.2) + Vec3::ONE.normalize() * 0.6;
+        assert!(close(at(r, corner.to_array()), 0.5), "rounded corner");
+    }
+
+    #[test]
+    fn cylinder_cone_torus_capsule_and_plane_at_known_points() {
+        let c = "cylinder(0.4, 0.6)";
+        assert!(close(at(c, [1.0, 0.0, 0.0]), 0.6));
+        assert!(close(at(c, [0.0, 0.0, 1.0]), 0.4));
+        assert!(close(at(c, [0.7, 0.0, 1.0]), 0.5), "beyond the rim: 0.3-0.4-0.5 triangle");
+        assert!(close(at(c, [0.0, 0.1, 0.0]), -0.3));
+        let k = "cone(0.5, 0.8)";
+        assert!(close(at(k, [0.0, 0.0, 1.8]), 1.0), "above the apex");
+        assert!(close(at(k, [0.0, 0.0, -1.0]), 1.0), "below the base");
+        assert!(close(at(k, [0.9, 0.0, -0.3]), 0.5), "beyond the base rim");
+        assert!(close(at(k, [0.0, 0.3, 0.0]), 0.0), "on the base disc");
+        let slant = (0.5f32 * 0.5 + 0.8 * 0.8).sqrt();
+        assert!(close(at(k, [0.0, 0.0, 0.4]), -0.4 * 0.5 / slant), "inside: distance to the side");
+        let t = "torus(0.6, 0.2)";
+        assert!(close(at(t, [0.6, 0.0, 0.0]), -0.2));
+        assert!(close(at(t, [0.0, 0.0, 0.0]), 0.4));
+        assert!(close(at(t, [0.0, -0.6, 0.5]), 0.3));
+        let s = "capsule(0, 0, 0, 1, 0, 0, 0.25)";
+        assert!(close(at(s, [0.5, 1.0, 0.0]), 0.75));
+        assert!(close(at(s, [-1.0, 0.0, 0.0]), 0.75));
+        assert!(close(at(s, [2.0, 0.0, 0.0]), 0.75));
+        let pl = "plane(0, 3, 4, 1)";
+        assert!(close(at(pl, [7.0, 3.0, 4.0]), 4.0), "normal is normalised: (3·3 + 4·4)/5 - 1");
+    }
+
+    #[test]
+    fn translate_shifts_and_scale_keeps_distances() {
+        let mut rng = Rng::new(41);
+        let base = compile("torus(0.6, 0.2)").unwrap();
+        let moved = compile("translate(torus(0.6, 0.2), 0.25, -0.5, 1)").unwrap();
+        let big = compile("scale(torus(0.6, 0.2), 2)").unwrap();
+        let d = Vec3::new(0.25, -0.5, 1.0);
+        for _ in 0..100 {
+            let p = rng.vec3(-1.5, 1.5);
+            assert!(close(moved.eval(p + d), base.eval(p)));
+            assert!(close(big.eval(p * 2.0), 2.0 * base.eval(p)), "a scaled distance is still a distance");
+        }
+    }
+
+    #[test]
+    fn rotate_by_right_angles_maps_axes_onto_axes() {
+        // A rod along x, rotated 90° about z, lies along y (right-hand rule).
+        let rod = "box(1, 0.1, 0.1)";
+        let turned = compile(&format!("rotate({rod}, 0, 0, 1, 90)")).unwrap();
+        assert!(turned.eval(Vec3::new(0.0, 0.9, 0.0)) < 0.0);
+        assert!(turned.eval(Vec3::new(0.9, 0.0, 0.0)) > 0.0);
+        assert_eq!(turned.eval(Vec3::new(0.0, 1.5, 0.0)), 0.5, "exact, no 1e-8 wobble");
+        // About x, y goes to z; about y, z goes to x.
+        let p = compile("rotate(translate(sphere(0.1), 0, 1, 0), 1, 0, 0, 90)").unwrap();
+        assert_eq!(p.eval(Vec3::new(0.0, 0.0, 1.0)), -0.1);
+        let p = compile("rotate(translate(sphere(0.1), 0, 0, 1), 0, 2, 0, 90)").unwrap();
+        assert_eq!(p.eval(Vec3::new(1.0, 0.0, 0.0)), -0.1);
+        // Right-angle rotations need no more instructions than a relabelling of axes.
+        let plain = compile(rod).unwrap().instruction_count();
+        assert!(turned.instruction_count() <= plain, "{turned}");
+        let r = rotation_matrix([1.0, 1.0, 1.0], 120.0).unwrap();
+        let x_to = [r[0][0], r[1][0], r[2][0]];
+        assert!((x_to[1] - 1.0).abs() < 1e-12, "120° about the diagonal cycles x to y: {x_to:?}");
+        assert!(rotation_matrix([0.0; 3], 10.0).is_none());
+    }
+
+    #[test]
+    fn rotation_with_varying_parameters_matches_the_constant_path() {
+        // The same angle, once as a constant and once through an expression the folder cannot see
+        // through (x * 0 is not folded): the general tape formula must agree with the matrix.
+        let fixed = compile("rotate(box(0.5, 0.2, 0.1), 1, 2, 3, 35)").unwrap();
+        let varying = compile("rotate(box(0.5, 0.2, 0.1), 1 + x * 0, 2, 3, 35 + y * 0)").unwrap();
+        assert!(varying.instruction_count() > fixed.instruction_count());
+        let mut rng = Rng::new(42);
+        for _ in 0..100 {
+            let p = rng.vec3(-1.0, 1.0);
+            assert!((fixed.eval(p) - varying.eval(p)).abs() < 1e-5, "at {p}");
+        }
+    }
+
+    #[test]
+    fn mirrors_and_booleans() {
+        let m = compile("mirror_x(translate(sphere(0.2), 0.5, 0, 0))").unwrap();
+        assert_eq!(m.eval(Vec3::new(-0.5, 0.0, 0.0)), -0.2);
+        assert_eq!(m.eval(Vec3::new(0.5, 0.0, 0.0)), -0.2);
+        let m = compile("mirror_z(translate(sphere(0.2), 0, 0, 0.5))").unwrap();
+        assert_eq!(m.eval(Vec3::new(0.0, 0.0, -0.5)), -0.2);
+        assert!(close(at("subtract(sphere(1), sphere(0.5))", [0.0, 0.0, 0.0]), 0.5));
+        assert!(close(at("intersect(sphere(1), box(0.2, 2, 2))", [0.0, 0.0, 0.0]), -0.2));
+        assert!(close(at("shell(sphere(1), 0.1)", [0.0, 0.0, 0.0]), 0.9));
+        assert!(close(at("offset(sphere(1), 0.25)", [2.0, 0.0, 0.0]), 0.75));
+        // Smooth blends equal the sharp ones away from the seam, and dip below them on it.
+        let s = compile("smooth_union(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0), 0.2)").unwrap();
+        let h = compile("union(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))").unwrap();
+        assert_eq!(s.eval(Vec3::new(-0.3, 0.0, 0.0)), h.eval(Vec3::new(-0.3, 0.0, 0.0)));
+        let seam = Vec3::new(0.4, 0.3, 0.0);
+        assert!(s.eval(seam) < h.eval(seam) - 0.01);
+        let si = compile("smooth_intersect(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0), 0.2)").unwrap();
+        let hi = compile("intersect(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))").unwrap();
+        assert!(si.eval(Vec3::new(0.4, 0.0, 0.0)) > hi.eval(Vec3::new(0.4, 0.0, 0.0)));
+        let ss = compile("smooth_subtract(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0), 0.2)").unwrap();
+        assert_eq!(ss.eval(Vec3::new(-0.45, 0.0, 0.0)), at("subtract(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))", [-0.45, 0.0, 0.0]));
+    }
 }
