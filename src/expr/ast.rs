@@ -66,7 +66,10 @@ pub enum ExprKind {
     /// `first op1 e1 op2 e2 …`, evaluated left to right. Kept flat rather than as nested binary
     /// nodes so that a machine-generated sum of ten thousand terms is not ten thousand levels of
     /// recursion (and stack) in every pass over the tree.
-    Chain { first: Box<Expr>, rest: Vec<(ChainOp, Expr)> },
+    Chain {
+        first: Box<Expr>,
+        rest: Vec<(ChainOp, Expr)>,
+    },
     /// `base ^ exponent`.
     Power(Box<Expr>, Box<Expr>),
     Call(Builtin, Vec<Expr>),

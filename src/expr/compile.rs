@@ -162,7 +162,12 @@ fn apply<B: Emit>(b: &mut B, f: Builtin, v: &[B::V], p: [B::V; 3], span: Span) -
             b.sub(a, v[1])
         }
         Builtin::Offset => b.sub(v[0], v[1]),
-        Builtin::Translate | Builtin::Rotate | Builtin::Scale | Builtin::MirrorX | Builtin::MirrorY | Builtin::MirrorZ => {
+        Builtin::Translate
+        | Builtin::Rotate
+        | Builtin::Scale
+        | Builtin::MirrorX
+        | Builtin::MirrorY
+        | Builtin::MirrorZ => {
             return Err(Diag::new(span, format!("internal: transform '{}' reached apply", f.name())));
         }
     })
@@ -226,7 +231,8 @@ impl Backend for GraphBackend {
 pub fn compile_script(script: &Script) -> Result<Program, Diag> {
     let mut graph = Graph::new();
     let base = graph.inputs();
-    let mut b = GraphBackend { graph, base, bindings: Vec::with_capacity(script.bindings.len()), moved: HashMap::new() };
+    let mut b =
+        GraphBackend { graph, base, bindings: Vec::with_capacity(script.bindings.len()), moved: HashMap::new() };
     for binding in &script.bindings {
         let v = lower(&mut b, script, &binding.value, base, 0)?;
         b.check(binding.span)?;

@@ -37,6 +37,8 @@ use super::parser::MAX_NESTING;
 use crate::error::Error;
 use serde::Serialize;
 
+/// One node of a shape tree; the variants mirror the language's shape functions (see the module
+/// docs for the JSON spelling). `Union` and `Intersect` need at least one shape.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "op", rename_all = "snake_case")]
 pub enum CsgNode {
@@ -48,9 +50,7 @@ pub enum CsgNode {
     Torus { major: f64, minor: f64 },
     Capsule { a: [f64; 3], b: [f64; 3], radius: f64 },
     Plane { normal: [f64; 3], distance: f64 },
-    /// At least one shape.
     Union { args: Vec<CsgNode> },
-    /// At least one shape.
     Intersect { args: Vec<CsgNode> },
     Subtract { args: Box<[CsgNode; 2]> },
     SmoothUnion { args: Box<[CsgNode; 2]>, k: f64 },
@@ -267,10 +267,15 @@ mod tests {
         assert!(message.contains("unknown field `radiuss`"), "{message}");
         let (_, _, message) = json_error(r#"{"op": "union", "args": []}"#);
         assert!(message.contains("at least 1 shape for `union`"), "{message}");
-        let (line, _, message) = json_error("{\"op\": \"translate\",\n \"shape\": {\"op\": \"sphere\", \"radius\": 1},\n \"radius\": 2}");
+        let (line, _, message) =
+            json_error("{\"op\": \"translate\",\n \"shape\": {\"op\": \"sphere\", \"radius\": 1},\n \"radius\": 2}");
         assert_eq!(line, 3, "reported at the end of the node it does not belong to");
-        assert!(message.contains("field `radius` does not belong to `translate`, which takes `shape`, `offset`"), "{message}");
-        let (line, _, message) = json_error("{\"op\": \"scale\", \"factor\": 2, \"shape\":\n {\"op\": \"torus\", \"major\": 1}}");
+        assert!(
+            message.contains("field `radius` does not belong to `translate`, which takes `shape`, `offset`"),
+            "{message}"
+        );
+        let (line, _, message) =
+            json_error("{\"op\": \"scale\", \"factor\": 2, \"shape\":\n {\"op\": \"torus\", \"major\": 1}}");
         assert_eq!(line, 2);
         assert!(message.contains("missing field `minor`"), "{message}");
         let (_, _, message) = json_error(r#"{"op": "subtract", "args": [{"op": "sphere", "radius": 1}]}"#);
@@ -292,7 +297,9 @@ mod tests {
             deep = CsgNode::Offset { shape: Box::new(deep), distance: 0.0 };
         }
         assert!(Program::from_csg(&deep).unwrap_err().to_string().contains("nested deeper"));
-        let nested = "{\"op\":\"offset\",\"distance\":0,\"shape\":".repeat(200) + "{\"op\":\"sphere\",\"radius\":1}" + &"}".repeat(200);
+        let nested = "{\"op\":\"offset\",\"distance\":0,\"shape\":".repeat(200)
+            + "{\"op\":\"sphere\",\"radius\":1}"
+            + &"}".repeat(200);
         assert!(Program::from_csg_json(&nested).is_err(), "serde_json's recursion limit applies");
     }
 }

@@ -181,8 +181,8 @@ impl Emit for Graph {
         // and `x * 0` is not (inf * 0 is NaN).
         match (op, ca, cb) {
             (BinaryOp::Sub, _, Some(z)) if z == 0.0 && z.is_sign_positive() => return a,
-            (BinaryOp::Mul, Some(o), _) if o == 1.0 => return b,
-            (BinaryOp::Mul | BinaryOp::Div, _, Some(o)) if o == 1.0 => return a,
+            (BinaryOp::Mul, Some(1.0), _) => return b,
+            (BinaryOp::Mul | BinaryOp::Div, _, Some(1.0)) => return a,
             _ => {}
         }
         let (a, b) = if op.is_commutative() && b < a { (b, a) } else { (a, b) };

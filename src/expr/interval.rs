@@ -44,7 +44,10 @@ impl Interval {
     pub const EVERYTHING: Interval = Interval { lo: f32::NEG_INFINITY, hi: f32::INFINITY };
 
     pub fn new(lo: f32, hi: f32) -> Interval {
-        Interval { lo: if lo.is_nan() { f32::NEG_INFINITY } else { lo }, hi: if hi.is_nan() { f32::INFINITY } else { hi } }
+        Interval {
+            lo: if lo.is_nan() { f32::NEG_INFINITY } else { lo },
+            hi: if hi.is_nan() { f32::INFINITY } else { hi },
+        }
     }
 
     pub fn point(v: f32) -> Interval {
@@ -130,13 +133,15 @@ impl Interval {
     /// `sin` or `cos`, whose maxima sit at `max_at + 2kπ` and minima half a period later.
     fn periodic(self, f: impl Fn(f32) -> f32, max_at: f64) -> Interval {
         let (lo, hi) = (self.lo as f64, self.hi as f64);
-        if !(hi - lo < 2.0 * PI) {
+        // (The width is NaN only for an infinite point, where anything goes too.)
+        if (hi - lo).is_nan() || hi - lo >= 2.0 * PI {
             return Interval::new(-1.0, 1.0);
         }
         let has = |peak: f64| {
             // Is there a k with lo <= peak + 2kπ <= hi? A little slack keeps it conservative.
             let k = ((lo - peak) / (2.0 * PI)).ceil();
-            peak + 2.0 * PI * k <= hi + 1e-9 * (1.0 + hi.abs()) || peak + 2.0 * PI * (k - 1.0) >= lo - 1e-9 * (1.0 + lo.abs())
+            peak + 2.0 * PI * k <= hi + 1e-9 * (1.0 + hi.abs())
+                || peak + 2.0 * PI * (k - 1.0) >= lo - 1e-9 * (1.0 + lo.abs())
         };
         let ends = Interval::hull(&[f(self.lo), f(self.hi)]).widen(2);
         let top = if has(max_at) { 1.0 } else { ends.hi.min(1.0) };
@@ -146,7 +151,7 @@ impl Interval {
 
     fn tan(self) -> Interval {
         let (lo, hi) = (self.lo as f64, self.hi as f64);
-        if !(hi - lo < PI) {
+        if (hi - lo).is_nan() || hi - lo >= PI {
             return Interval::EVERYTHING;
         }
         // The pole after lo; with slack, because f32 inputs near a pole round unpredictably.
@@ -309,11 +314,15 @@ mod tests {
                 let (a, b) = program.eval_interval(lo, hi);
                 assert!(a <= b, "{case}: empty bounds [{a}, {b}]");
                 finite += usize::from(a.is_finite() && b.is_finite());
-                let corners = (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo));
+                let corners =
+                    (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo));
                 let inside: Vec<Vec3> = (0..40).map(|_| sample(&mut rng, lo, hi)).collect();
                 for p in corners.chain(inside) {
                     let v = program.eval(p);
-                    assert!(v.is_nan() || (a <= v && v <= b), "{case}: {v} at {p} outside [{a}, {b}] for box {lo}..{hi}");
+                    assert!(
+                        v.is_nan() || (a <= v && v <= b),
+                        "{case}: {v} at {p} outside [{a}, {b}] for box {lo}..{hi}"
+                    );
                 }
             }
             assert!(finite > 20, "{case}: bounds were almost always infinite, which proves nothing");
@@ -377,7 +386,11 @@ mod tests {
                 for _ in 0..20 {
                     let (x, y) = (inside(&mut rng, a), inside(&mut rng, b));
                     let v = ops::binary(op, x, y);
-                    assert!(v.is_nan() || r.contains(v), "{}({x}, {y}) = {v} outside {r:?} for {a:?}, {b:?}", op.name());
+                    assert!(
+                        v.is_nan() || r.contains(v),
+                        "{}({x}, {y}) = {v} outside {r:?} for {a:?}, {b:?}",
+                        op.name()
+                    );
                 }
             }
         }
@@ -402,12 +415,16 @@ mod tests {
         assert!(u(UnaryOp::Cos, i(-0.1, 0.1)).lo > 0.99);
         assert_eq!(u(UnaryOp::Cos, i(0.0, 7.0)), i(-1.0, 1.0));
         assert_eq!(u(UnaryOp::Ln, i(-1.0, 0.0)).hi, f32::NEG_INFINITY);
-        assert_eq!(Interval::binary(BinaryOp::Sub, i(f32::NEG_INFINITY, 0.0), i(f32::NEG_INFINITY, 0.0)).hi, f32::INFINITY);
+        assert_eq!(
+            Interval::binary(BinaryOp::Sub, i(f32::NEG_INFINITY, 0.0), i(f32::NEG_INFINITY, 0.0)).hi,
+            f32::INFINITY
+        );
     }
 
     #[test]
     fn choices_name_the_branch_that_wins_and_simplify_keeps_values() {
-        let program = compile("union(translate(sphere(0.5), -1, 0, 0), translate(box(0.4, 0.4, 0.4), 1, 0, 0))").unwrap();
+        let program =
+            compile("union(translate(sphere(0.5), -1, 0, 0), translate(box(0.4, 0.4, 0.4), 1, 0, 0))").unwrap();
         assert_eq!(program.choice_count(), 7, "{program}"); // the union and six in the box
         let near_sphere = (Vec3::new(-1.2, -0.2, -0.2), Vec3::new(-0.8, 0.2, 0.2));
         let (_, choices) = program.eval_interval_with_choices(near_sphere.0, near_sphere.1);

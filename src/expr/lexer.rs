@@ -181,10 +181,14 @@ fn number(source: &str, start: usize) -> Result<(TokenKind, usize), Diag> {
         return Err(Diag::new(Span::new(start, bad_end), format!("malformed number '{text}'{hint}")));
     }
     let text = &source[start..end];
-    let value: f64 = text.parse().map_err(|_| Diag::new(Span::new(start, end), format!("malformed number '{text}'")))?;
+    let value: f64 =
+        text.parse().map_err(|_| Diag::new(Span::new(start, end), format!("malformed number '{text}'")))?;
     // Evaluation is in f32: a literal that only fits in f64 would silently become infinity.
     if !(value as f32).is_finite() {
-        return Err(Diag::new(Span::new(start, end), format!("number '{text}' is too large (the limit is about 3.4e38)")));
+        return Err(Diag::new(
+            Span::new(start, end),
+            format!("number '{text}' is too large (the limit is about 3.4e38)"),
+        ));
     }
     Ok((TokenKind::Number(value), end))
 }
@@ -200,13 +204,19 @@ mod tests {
     #[test]
     fn numbers_in_every_accepted_form() {
         use TokenKind::Number as N;
-        assert_eq!(kinds(".5 1e-3 2. 3.25E+2 7 1.e1"), vec![N(0.5), N(1e-3), N(2.0), N(325.0), N(7.0), N(10.0), TokenKind::Eof]);
+        assert_eq!(
+            kinds(".5 1e-3 2. 3.25E+2 7 1.e1"),
+            vec![N(0.5), N(1e-3), N(2.0), N(325.0), N(7.0), N(10.0), TokenKind::Eof]
+        );
     }
 
     #[test]
     fn comments_and_whitespace_disappear() {
         let k = kinds("x # note\n+ /* block\n * still */ y // end\n");
-        assert_eq!(k, vec![TokenKind::Ident("x".into()), TokenKind::Plus, TokenKind::Ident("y".into()), TokenKind::Eof]);
+        assert_eq!(
+            k,
+            vec![TokenKind::Ident("x".into()), TokenKind::Plus, TokenKind::Ident("y".into()), TokenKind::Eof]
+        );
     }
 
     #[test]

@@ -76,8 +76,8 @@ mod testutil;
 
 pub use ast::Script;
 pub use builtins::{Arity, Builtin};
-pub use diag::Span;
 pub use csg::CsgNode;
+pub use diag::Span;
 pub use interval::Choice;
 pub use program::Program;
 
@@ -149,7 +149,9 @@ mod tests {
 
     #[test]
     fn the_module_example_holds() {
-        let p = compile("body = rounded_box(1, 0.6, 0.4, 0.1);\nsubtract(body, translate(cylinder(0.25, 2), 0.3, 0, 0))").unwrap();
+        let p =
+            compile("body = rounded_box(1, 0.6, 0.4, 0.1);\nsubtract(body, translate(cylinder(0.25, 2), 0.3, 0, 0))")
+                .unwrap();
         assert!(p.eval(Vec3::new(-0.6, 0.0, 0.0)) < 0.0);
         assert!(p.eval(Vec3::new(0.3, 0.0, 0.0)) > 0.0, "in the hole");
     }

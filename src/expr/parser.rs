@@ -243,7 +243,8 @@ impl Parser {
             } else if matches!(name.as_str(), "x" | "y" | "z") {
                 format!("'{name}' is a coordinate, not a function")
             } else {
-                let hint = suggest(&name, Builtin::names()).map(|s| format!("; did you mean '{s}'?")).unwrap_or_default();
+                let hint =
+                    suggest(&name, Builtin::names()).map(|s| format!("; did you mean '{s}'?")).unwrap_or_default();
                 format!("unknown function '{name}'{hint}")
             };
             return Err(Diag::new(name_span, message));
@@ -270,12 +271,7 @@ impl Parser {
         if !builtin.arity().accepts(args.len()) {
             return Err(Diag::new(
                 name_span,
-                format!(
-                    "'{name}' takes {} ({}), but was given {}",
-                    builtin.arity(),
-                    builtin.signature(),
-                    args.len()
-                ),
+                format!("'{name}' takes {} ({}), but was given {}", builtin.arity(), builtin.signature(), args.len()),
             ));
         }
         Ok(Expr::new(ExprKind::Call(builtin, args), span))

@@ -503,6 +503,9 @@ mod tests {
         let hi = compile("intersect(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))").unwrap();
         assert!(si.eval(Vec3::new(0.4, 0.0, 0.0)) > hi.eval(Vec3::new(0.4, 0.0, 0.0)));
         let ss = compile("smooth_subtract(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0), 0.2)").unwrap();
-        assert_eq!(ss.eval(Vec3::new(-0.45, 0.0, 0.0)), at("subtract(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))", [-0.45, 0.0, 0.0]));
+        assert_eq!(
+            ss.eval(Vec3::new(-0.45, 0.0, 0.0)),
+            at("subtract(sphere(0.5), translate(sphere(0.5), 0.8, 0, 0))", [-0.45, 0.0, 0.0])
+        );
     }
 }

@@ -168,7 +168,10 @@ mod tests {
         let r = g.sqrt(s);
         let (nodes, root) = g.compact(r);
         let text = Tape::from_nodes(&nodes, root).to_string();
-        assert!(text.contains("= x") && text.contains("= y") && text.contains("add") && text.contains("sqrt"), "{text}");
+        assert!(
+            text.contains("= x") && text.contains("= y") && text.contains("add") && text.contains("sqrt"),
+            "{text}"
+        );
         assert!(!text.contains("= z"), "z is not read: {text}");
     }
 }
