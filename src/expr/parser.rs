@@ -89,7 +89,9 @@ impl Parser {
 
     fn binding(&mut self) -> Result<(), Diag> {
         let name_tok = self.bump();
-        let TokenKind::Ident(name) = name_tok.kind else { unreachable!("checked by the caller") };
+        let TokenKind::Ident(name) = name_tok.kind else {
+            return Err(Diag::new(name_tok.span, "expected a name to bind"));
+        };
         if matches!(name.as_str(), "x" | "y" | "z") {
             return Err(Diag::new(name_tok.span, format!("cannot bind '{name}': it is a coordinate")));
         }

@@ -52,14 +52,19 @@ impl Program {
         eval_point(&self.tape, p)
     }
 
-    /// The value and its exact gradient at `p` (forward-mode differentiation; see
-    /// [`super::eval`] for the conventions at kinks). The value equals [`Program::eval`]'s.
+    /// The value and its exact gradient at `p` (forward-mode differentiation). Where there is no
+    /// derivative: min/max pass on the taken branch's gradient (the left one on a tie), `abs`
+    /// takes `+` at zero, `sqrt(0)` and `atan2(0, 0)` contribute zero, `floor` is flat. The value
+    /// equals [`Program::eval`]'s.
     pub fn eval_grad(&self, p: Vec3) -> (f32, Vec3) {
         eval_gradient(&self.tape, p)
     }
 
-    /// Bounds `(lo, hi)` on the value over the box between corners `lo` and `hi`; see
-    /// [`super::interval`] for exactly what is guaranteed.
+    /// Bounds `(lo, hi)` on the value over the box between corners `lo` and `hi`, containing what
+    /// [`Program::eval`] returns at every point of the box where it is not NaN (`f32` rounding
+    /// included). Points where an operation is undefined are left out (`sqrt([-1, 4])` is
+    /// `[0, 2]`); dividing by a range that contains zero gives `(-inf, inf)`; `sin`/`cos` find
+    /// their extrema across any number of periods.
     pub fn eval_interval(&self, lo: Vec3, hi: Vec3) -> (f32, f32) {
         let r = interval::eval_interval(&self.tape, lo, hi);
         (r.lo, r.hi)
