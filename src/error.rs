@@ -18,6 +18,10 @@ pub enum Error {
     UnknownName { kind: &'static str, name: String, known: Vec<String> },
     /// Reading or writing a file failed.
     Io(String),
+    /// Text the user typed (an expression program, a CSG JSON document) is malformed or names
+    /// something unknown. `line` and `column` are 1-based (column counts characters); `snippet`
+    /// is the whole offending source line, so the message stands alone.
+    Parse { message: String, line: usize, column: usize, snippet: String },
 }
 
 impl fmt::Display for Error {
@@ -38,6 +42,14 @@ impl fmt::Display for Error {
                 write!(f, "unknown {kind} '{name}'; known: {}", known.join(", "))
             }
             Error::Io(msg) => write!(f, "{msg}"),
+            Error::Parse { message, line, column, snippet } => {
+                write!(f, "{line}:{column}: {message}\n{snippet}\n")?;
+                // Copy tabs from the line so the caret lands under the same column in a terminal.
+                for c in snippet.chars().take(column.saturating_sub(1)) {
+                    f.write_str(if c == '\t' { "\t" } else { " " })?;
+                }
+                f.write_str("^")
+            }
         }
     }
 }

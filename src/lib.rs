@@ -3,6 +3,8 @@
 //! The crate is organised in rooms, each owning one idea:
 //! - [`grid`]: where samples live (bounds, dimensions, index → world mapping, size caps).
 //! - [`field`]: what is sampled (the [`field::Field`] trait, closures, sampled volumes).
+//! - [`expr`]: fields typed as text or built as CSG JSON, compiled to a flat tape (values, exact
+//!   gradients, interval bounds, batches).
 //! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
@@ -13,6 +15,7 @@
 
 pub mod emc;
 pub mod error;
+pub mod expr;
 pub mod field;
 pub mod grid;
 pub mod mc;
