@@ -23,7 +23,13 @@ use std::collections::HashMap;
 /// What lowering needs beyond arithmetic: the value of a binding at given coordinates.
 pub trait Backend: Emit {
     /// `depth` is the tree depth of the reference, for backends that walk the binding's tree.
-    fn binding(&mut self, script: &Script, index: usize, at: [Self::V; 3], depth: usize) -> Result<Self::V, Diag>;
+    fn binding(
+        &mut self,
+        script: &Script,
+        index: usize,
+        at: [Self::V; 3],
+        depth: usize,
+    ) -> Result<Self::V, Diag>;
 
     /// Called after each call is lowered, so a runaway expansion stops early.
     fn check(&self, _span: Span) -> Result<(), Diag> {
@@ -36,7 +42,13 @@ pub trait Backend: Emit {
 pub const MAX_TREE_DEPTH: usize = 4 * MAX_NESTING;
 
 /// The value of `expr` with `p` standing in for the coordinates.
-pub fn lower<B: Backend>(b: &mut B, script: &Script, expr: &Expr, p: [B::V; 3], depth: usize) -> Result<B::V, Diag> {
+pub fn lower<B: Backend>(
+    b: &mut B,
+    script: &Script,
+    expr: &Expr,
+    p: [B::V; 3],
+    depth: usize,
+) -> Result<B::V, Diag> {
     if depth > MAX_TREE_DEPTH {
         return Err(Diag::new(expr.span, format!("expression nests deeper than {MAX_TREE_DEPTH} levels")));
     }
@@ -199,7 +211,13 @@ impl Emit for GraphBackend {
 }
 
 impl Backend for GraphBackend {
-    fn binding(&mut self, script: &Script, index: usize, at: [NodeId; 3], _depth: usize) -> Result<NodeId, Diag> {
+    fn binding(
+        &mut self,
+        script: &Script,
+        index: usize,
+        at: [NodeId; 3],
+        _depth: usize,
+    ) -> Result<NodeId, Diag> {
         let Some(&built) = self.bindings.get(index) else {
             let name = script.bindings.get(index).map_or("?", |b| b.name.as_str());
             return Err(Diag::new(Span::default(), format!("binding '{name}' is used before it is defined")));
@@ -231,8 +249,12 @@ impl Backend for GraphBackend {
 pub fn compile_script(script: &Script) -> Result<Program, Diag> {
     let mut graph = Graph::new();
     let base = graph.inputs();
-    let mut b =
-        GraphBackend { graph, base, bindings: Vec::with_capacity(script.bindings.len()), moved: HashMap::new() };
+    let mut b = GraphBackend {
+        graph,
+        base,
+        bindings: Vec::with_capacity(script.bindings.len()),
+        moved: HashMap::new(),
+    };
     for binding in &script.bindings {
         let v = lower(&mut b, script, &binding.value, base, 0)?;
         b.check(binding.span)?;
@@ -369,9 +391,16 @@ mod tests {
         use super::super::{Builtin, Program};
         let e = |kind| Expr::synthetic(kind);
         let wrong_arity = Script { bindings: vec![], body: e(ExprKind::Call(Builtin::Sphere, vec![])) };
-        assert!(Program::from_script(&wrong_arity).unwrap_err().to_string().contains("'sphere' takes 1 argument"));
+        assert!(Program::from_script(&wrong_arity)
+            .unwrap_err()
+            .to_string()
+            .contains("'sphere' takes 1 argument"));
         let forward = Script {
-            bindings: vec![Binding { name: "a".into(), span: Default::default(), value: e(ExprKind::Binding(0)) }],
+            bindings: vec![Binding {
+                name: "a".into(),
+                span: Default::default(),
+                value: e(ExprKind::Binding(0)),
+            }],
             body: e(ExprKind::Binding(0)),
         };
         assert!(Program::from_script(&forward).unwrap_err().to_string().contains("before it is defined"));

@@ -76,12 +76,18 @@ fn parts(node: &CsgNode) -> (Builtin, Vec<&CsgNode>, Vec<f64>) {
     match node {
         N::Sphere { radius } => (Builtin::Sphere, vec![], vec![*radius]),
         N::Box { half } => (Builtin::Box, vec![], half.to_vec()),
-        N::RoundedBox { half, radius } => (Builtin::RoundedBox, vec![], vec![half[0], half[1], half[2], *radius]),
+        N::RoundedBox { half, radius } => {
+            (Builtin::RoundedBox, vec![], vec![half[0], half[1], half[2], *radius])
+        }
         N::Cylinder { radius, half_height } => (Builtin::Cylinder, vec![], vec![*radius, *half_height]),
         N::Cone { radius, height } => (Builtin::Cone, vec![], vec![*radius, *height]),
         N::Torus { major, minor } => (Builtin::Torus, vec![], vec![*major, *minor]),
-        N::Capsule { a, b, radius } => (Builtin::Capsule, vec![], vec![a[0], a[1], a[2], b[0], b[1], b[2], *radius]),
-        N::Plane { normal, distance } => (Builtin::Plane, vec![], vec![normal[0], normal[1], normal[2], *distance]),
+        N::Capsule { a, b, radius } => {
+            (Builtin::Capsule, vec![], vec![a[0], a[1], a[2], b[0], b[1], b[2], *radius])
+        }
+        N::Plane { normal, distance } => {
+            (Builtin::Plane, vec![], vec![normal[0], normal[1], normal[2], *distance])
+        }
         N::Union { args } => (Builtin::Union, args.iter().collect(), vec![]),
         N::Intersect { args } => (Builtin::Intersect, args.iter().collect(), vec![]),
         N::Subtract { args } => (Builtin::Subtract, pair(args), vec![]),
@@ -91,7 +97,9 @@ fn parts(node: &CsgNode) -> (Builtin, Vec<&CsgNode>, Vec<f64>) {
         N::Shell { shape, thickness } => (Builtin::Shell, vec![shape], vec![*thickness]),
         N::Offset { shape, distance } => (Builtin::Offset, vec![shape], vec![*distance]),
         N::Translate { shape, offset } => (Builtin::Translate, vec![shape], offset.to_vec()),
-        N::Rotate { shape, axis, degrees } => (Builtin::Rotate, vec![shape], vec![axis[0], axis[1], axis[2], *degrees]),
+        N::Rotate { shape, axis, degrees } => {
+            (Builtin::Rotate, vec![shape], vec![axis[0], axis[1], axis[2], *degrees])
+        }
         N::Scale { shape, factor } => (Builtin::Scale, vec![shape], vec![*factor]),
         N::MirrorX { shape } => (Builtin::MirrorX, vec![shape], vec![]),
         N::MirrorY { shape } => (Builtin::MirrorY, vec![shape], vec![]),
@@ -205,8 +213,14 @@ mod tests {
                     }),
                     offset: [0.7, -0.1, 0.0],
                 },
-                CsgNode::SmoothUnion { args: b([CsgNode::Cone { radius: 0.3, height: 0.6 }, s(0.2)]), k: 0.1 },
-                CsgNode::SmoothIntersect { args: b([CsgNode::Torus { major: 0.5, minor: 0.1 }, s(0.55)]), k: 0.05 },
+                CsgNode::SmoothUnion {
+                    args: b([CsgNode::Cone { radius: 0.3, height: 0.6 }, s(0.2)]),
+                    k: 0.1,
+                },
+                CsgNode::SmoothIntersect {
+                    args: b([CsgNode::Torus { major: 0.5, minor: 0.1 }, s(0.55)]),
+                    k: 0.05,
+                },
                 CsgNode::SmoothSubtract {
                     args: b([CsgNode::RoundedBox { half: [0.3, 0.3, 0.3], radius: 0.05 }, s(0.3)]),
                     k: 0.02,
@@ -218,8 +232,13 @@ mod tests {
                     ],
                 },
                 CsgNode::Shell { shape: b(s(0.9)), thickness: 0.02 },
-                CsgNode::Offset { shape: b(CsgNode::Scale { shape: b(s(0.1)), factor: 1.5 }), distance: 0.01 },
-                CsgNode::MirrorZ { shape: b(CsgNode::Translate { shape: b(s(0.1)), offset: [0.0, 0.0, 0.6] }) },
+                CsgNode::Offset {
+                    shape: b(CsgNode::Scale { shape: b(s(0.1)), factor: 1.5 }),
+                    distance: 0.01,
+                },
+                CsgNode::MirrorZ {
+                    shape: b(CsgNode::Translate { shape: b(s(0.1)), offset: [0.0, 0.0, 0.6] }),
+                },
                 CsgNode::MirrorX { shape: b(s(0.1)) },
                 CsgNode::MirrorY { shape: b(s(0.1)) },
             ],
@@ -230,12 +249,16 @@ mod tests {
     fn json_and_text_compile_to_the_same_tape() {
         let from_json = Program::from_csg_json(EXAMPLE).unwrap();
         let from_text =
-            compile("subtract(rounded_box(1, 0.6, 0.4, 0.1), translate(cylinder(0.25, 2), 0.3, 0, 0))").unwrap();
+            compile("subtract(rounded_box(1, 0.6, 0.4, 0.1), translate(cylinder(0.25, 2), 0.3, 0, 0))")
+                .unwrap();
         assert_eq!(from_json, from_text);
         let tree = everything();
         let text = tree.to_text();
         assert_eq!(Program::from_csg(&tree).unwrap(), compile(&text).unwrap(), "{text}");
-        assert!(text.starts_with("union(subtract(box(0.5, 0.4, 0.3), sphere(0.45)), translate(rotate("), "{text}");
+        assert!(
+            text.starts_with("union(subtract(box(0.5, 0.4, 0.3), sphere(0.45)), translate(rotate("),
+            "{text}"
+        );
         assert!(text.contains("translate(rotate(cylinder(0.2, 0.5), 1.0, 0.0, 0.0, -30.0), 0.7, -0.1, 0.0)"));
     }
 
@@ -267,8 +290,9 @@ mod tests {
         assert!(message.contains("unknown field `radiuss`"), "{message}");
         let (_, _, message) = json_error(r#"{"op": "union", "args": []}"#);
         assert!(message.contains("at least 1 shape for `union`"), "{message}");
-        let (line, _, message) =
-            json_error("{\"op\": \"translate\",\n \"shape\": {\"op\": \"sphere\", \"radius\": 1},\n \"radius\": 2}");
+        let (line, _, message) = json_error(
+            "{\"op\": \"translate\",\n \"shape\": {\"op\": \"sphere\", \"radius\": 1},\n \"radius\": 2}",
+        );
         assert_eq!(line, 3, "reported at the end of the node it does not belong to");
         assert!(
             message.contains("field `radius` does not belong to `translate`, which takes `shape`, `offset`"),
@@ -290,7 +314,11 @@ mod tests {
     fn trees_built_in_rust_are_checked_too() {
         let empty = CsgNode::Intersect { args: vec![] };
         assert!(Program::from_csg(&empty).unwrap_err().to_string().contains("at least one shape"));
-        let flat = CsgNode::Rotate { shape: Box::new(CsgNode::Sphere { radius: 1.0 }), axis: [0.0; 3], degrees: 5.0 };
+        let flat = CsgNode::Rotate {
+            shape: Box::new(CsgNode::Sphere { radius: 1.0 }),
+            axis: [0.0; 3],
+            degrees: 5.0,
+        };
         assert!(Program::from_csg(&flat).unwrap_err().to_string().contains("axis (0, 0, 0)"));
         let mut deep = CsgNode::Sphere { radius: 1.0 };
         for _ in 0..500 {

@@ -274,7 +274,10 @@ mod tests {
                 );
                 checked += 1;
             }
-            assert!(checked * 10 >= total * 7, "{case}: only {checked} of {total} points were away from kinks");
+            assert!(
+                checked * 10 >= total * 7,
+                "{case}: only {checked} of {total} points were away from kinks"
+            );
         }
     }
 

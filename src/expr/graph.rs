@@ -165,7 +165,9 @@ impl Emit for Graph {
         // Identities that hold for every input, NaN and signed zero included.
         match (op, self.node(a)) {
             (UnaryOp::Neg, Node::Unary(UnaryOp::Neg, inner)) => return inner,
-            (UnaryOp::Abs, Node::Unary(UnaryOp::Abs | UnaryOp::Neg, inner)) => return self.unary(UnaryOp::Abs, inner),
+            (UnaryOp::Abs, Node::Unary(UnaryOp::Abs | UnaryOp::Neg, inner)) => {
+                return self.unary(UnaryOp::Abs, inner)
+            }
             (UnaryOp::Powi(1), _) => return a,
             _ => {}
         }

@@ -295,7 +295,8 @@ mod tests {
     /// A random box: anywhere in the test cube, from tiny to most of the cube.
     fn random_box(rng: &mut Rng) -> (Vec3, Vec3) {
         let c = rng.vec3(-1.5, 1.5);
-        let h = Vec3::new(rng.range(-3.0, 0.0), rng.range(-3.0, 0.0), rng.range(-3.0, 0.0)).map(|e| 10f32.powf(e));
+        let h = Vec3::new(rng.range(-3.0, 0.0), rng.range(-3.0, 0.0), rng.range(-3.0, 0.0))
+            .map(|e| 10f32.powf(e));
         (c - h, c + h)
     }
 
@@ -314,8 +315,8 @@ mod tests {
                 let (a, b) = program.eval_interval(lo, hi);
                 assert!(a <= b, "{case}: empty bounds [{a}, {b}]");
                 finite += usize::from(a.is_finite() && b.is_finite());
-                let corners =
-                    (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo));
+                let corners = (0..8)
+                    .map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo));
                 let inside: Vec<Vec3> = (0..40).map(|_| sample(&mut rng, lo, hi)).collect();
                 for p in corners.chain(inside) {
                     let v = program.eval(p);
@@ -424,7 +425,8 @@ mod tests {
     #[test]
     fn choices_name_the_branch_that_wins_and_simplify_keeps_values() {
         let program =
-            compile("union(translate(sphere(0.5), -1, 0, 0), translate(box(0.4, 0.4, 0.4), 1, 0, 0))").unwrap();
+            compile("union(translate(sphere(0.5), -1, 0, 0), translate(box(0.4, 0.4, 0.4), 1, 0, 0))")
+                .unwrap();
         assert_eq!(program.choice_count(), 7, "{program}"); // the union and six in the box
         let near_sphere = (Vec3::new(-1.2, -0.2, -0.2), Vec3::new(-0.8, 0.2, 0.2));
         let (_, choices) = program.eval_interval_with_choices(near_sphere.0, near_sphere.1);

@@ -74,7 +74,12 @@ pub fn tokenize(source: &str) -> Result<Vec<Token>, Diag> {
             b'/' if bytes.get(i + 1) == Some(&b'*') => {
                 match source[i + 2..].find("*/") {
                     Some(end) => i += 2 + end + 2,
-                    None => return Err(Diag::new(Span::new(i, i + 2), "this block comment is never closed with '*/'")),
+                    None => {
+                        return Err(Diag::new(
+                            Span::new(i, i + 2),
+                            "this block comment is never closed with '*/'",
+                        ))
+                    }
                 }
                 continue;
             }
@@ -86,7 +91,10 @@ pub fn tokenize(source: &str) -> Result<Vec<Token>, Diag> {
             }
             b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
                 let end = ident_end(bytes, i);
-                tokens.push(Token { kind: TokenKind::Ident(source[i..end].to_string()), span: Span::new(i, end) });
+                tokens.push(Token {
+                    kind: TokenKind::Ident(source[i..end].to_string()),
+                    span: Span::new(i, end),
+                });
                 i = end;
                 continue;
             }
@@ -106,7 +114,10 @@ pub fn tokenize(source: &str) -> Result<Vec<Token>, Diag> {
             _ => {
                 let ch = source[i..].chars().next().unwrap_or('?');
                 let hint = if matches!(ch, '{' | '[') { "; group with '(' and ')'" } else { "" };
-                return Err(Diag::new(Span::new(i, i + ch.len_utf8()), format!("unexpected character '{ch}'{hint}")));
+                return Err(Diag::new(
+                    Span::new(i, i + ch.len_utf8()),
+                    format!("unexpected character '{ch}'{hint}"),
+                ));
             }
         };
         i += 1;

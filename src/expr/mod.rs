@@ -118,7 +118,8 @@ mod tests {
     #[test]
     fn no_input_makes_it_panic() {
         let mut rng = Rng::new(30);
-        let alphabet: Vec<char> = "xyz0123456789.eE+-*/^(),;=#\n\t /*abcdefghijklmnopqrstuvw_é$[]{}".chars().collect();
+        let alphabet: Vec<char> =
+            "xyz0123456789.eE+-*/^(),;=#\n\t /*abcdefghijklmnopqrstuvw_é$[]{}".chars().collect();
         for _ in 0..3000 {
             let len = rng.below(40);
             let text: String = (0..len).map(|_| alphabet[rng.below(alphabet.len())]).collect();
@@ -149,9 +150,10 @@ mod tests {
 
     #[test]
     fn the_module_example_holds() {
-        let p =
-            compile("body = rounded_box(1, 0.6, 0.4, 0.1);\nsubtract(body, translate(cylinder(0.25, 2), 0.3, 0, 0))")
-                .unwrap();
+        let p = compile(
+            "body = rounded_box(1, 0.6, 0.4, 0.1);\nsubtract(body, translate(cylinder(0.25, 2), 0.3, 0, 0))",
+        )
+        .unwrap();
         assert!(p.eval(Vec3::new(-0.6, 0.0, 0.0)) < 0.0);
         assert!(p.eval(Vec3::new(0.3, 0.0, 0.0)) > 0.0, "in the hole");
     }

@@ -31,7 +31,8 @@ impl Backend for Numbers {
     fn binding(&mut self, script: &Script, index: usize, at: [f32; 3], depth: usize) -> Result<f32, Diag> {
         // Re-reading the binding's tree counts as going deeper, so a hand-built self-reference
         // ends in an error instead of a stack overflow.
-        let binding = script.bindings.get(index).ok_or_else(|| Diag::new(Default::default(), "no such binding"))?;
+        let binding =
+            script.bindings.get(index).ok_or_else(|| Diag::new(Default::default(), "no such binding"))?;
         lower(self, script, &binding.value, at, depth + 1)
     }
 }

@@ -96,12 +96,18 @@ impl Parser {
             return Err(Diag::new(name_tok.span, format!("cannot bind '{name}': it is a coordinate")));
         }
         if Builtin::lookup(&name).is_some() {
-            return Err(Diag::new(name_tok.span, format!("cannot bind '{name}': it names a built-in function")));
+            return Err(Diag::new(
+                name_tok.span,
+                format!("cannot bind '{name}': it names a built-in function"),
+            ));
         }
         self.bump(); // '='
         let value = self.expr()?;
         if self.peek().kind != TokenKind::Semi {
-            return Err(Diag::new(self.after_previous(), format!("expected ';' after the binding of '{name}'")));
+            return Err(Diag::new(
+                self.after_previous(),
+                format!("expected ';' after the binding of '{name}'"),
+            ));
         }
         self.bump();
         self.bindings.push(Binding { name, span: name_tok.span, value });
@@ -229,8 +235,10 @@ impl Parser {
                     return Err(Diag::new(span, format!("'{name}' is a function; call it like {name}(…)")));
                 }
                 None => {
-                    let known = ["x", "y", "z"].into_iter().chain(self.bindings.iter().map(|b| b.name.as_str()));
-                    let hint = suggest(name, known).map(|s| format!("; did you mean '{s}'?")).unwrap_or_default();
+                    let known =
+                        ["x", "y", "z"].into_iter().chain(self.bindings.iter().map(|b| b.name.as_str()));
+                    let hint =
+                        suggest(name, known).map(|s| format!("; did you mean '{s}'?")).unwrap_or_default();
                     return Err(Diag::new(span, format!("unknown identifier '{name}'{hint}")));
                 }
             },
@@ -245,8 +253,9 @@ impl Parser {
             } else if matches!(name.as_str(), "x" | "y" | "z") {
                 format!("'{name}' is a coordinate, not a function")
             } else {
-                let hint =
-                    suggest(&name, Builtin::names()).map(|s| format!("; did you mean '{s}'?")).unwrap_or_default();
+                let hint = suggest(&name, Builtin::names())
+                    .map(|s| format!("; did you mean '{s}'?"))
+                    .unwrap_or_default();
                 format!("unknown function '{name}'{hint}")
             };
             return Err(Diag::new(name_span, message));
@@ -262,7 +271,10 @@ impl Parser {
                     }
                     TokenKind::RParen => break,
                     TokenKind::Eof => {
-                        return Err(Diag::new(name_span, format!("this call of '{name}' is never closed with ')'")));
+                        return Err(Diag::new(
+                            name_span,
+                            format!("this call of '{name}' is never closed with ')'"),
+                        ));
                     }
                     _ => return Err(self.unexpected("',' or ')'")),
                 }
@@ -273,7 +285,12 @@ impl Parser {
         if !builtin.arity().accepts(args.len()) {
             return Err(Diag::new(
                 name_span,
-                format!("'{name}' takes {} ({}), but was given {}", builtin.arity(), builtin.signature(), args.len()),
+                format!(
+                    "'{name}' takes {} ({}), but was given {}",
+                    builtin.arity(),
+                    builtin.signature(),
+                    args.len()
+                ),
             ));
         }
         Ok(Expr::new(ExprKind::Call(builtin, args), span))
@@ -369,6 +386,9 @@ mod tests {
     #[test]
     fn error_display_quotes_the_line_with_a_caret() {
         let err = compile("r = 0.5;\nsphere(r) + boxx(1, 1, 1)").unwrap_err().to_string();
-        assert_eq!(err, "2:13: unknown function 'boxx'; did you mean 'box'?\nsphere(r) + boxx(1, 1, 1)\n            ^");
+        assert_eq!(
+            err,
+            "2:13: unknown function 'boxx'; did you mean 'box'?\nsphere(r) + boxx(1, 1, 1)\n            ^"
+        );
     }
 }

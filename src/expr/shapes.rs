@@ -62,7 +62,9 @@ pub trait Emit {
     /// `a^b`; a small constant integer exponent becomes `Powi`, exact for negative bases too.
     fn pow(&mut self, a: Self::V, b: Self::V) -> Self::V {
         match self.as_constant(b) {
-            Some(e) if e.fract() == 0.0 && e.abs() <= MAX_POWI as f32 => self.unary(UnaryOp::Powi(e as i32), a),
+            Some(e) if e.fract() == 0.0 && e.abs() <= MAX_POWI as f32 => {
+                self.unary(UnaryOp::Powi(e as i32), a)
+            }
             _ => self.binary(BinaryOp::Pow, a, b),
         }
     }

@@ -95,7 +95,10 @@ impl Tape {
 
     /// How many min/max instructions there are: the length of a choice vector.
     pub fn choice_count(&self) -> usize {
-        self.instrs.iter().filter(|i| matches!(i, Instr::Binary { op: BinaryOp::Min | BinaryOp::Max, .. })).count()
+        self.instrs
+            .iter()
+            .filter(|i| matches!(i, Instr::Binary { op: BinaryOp::Min | BinaryOp::Max, .. }))
+            .count()
     }
 }
 
