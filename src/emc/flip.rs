@@ -6,8 +6,9 @@ use glam::Vec3;
 use std::collections::HashMap;
 
 /// One pass over all edges; returns how many were flipped. A flip is refused when the new edge
-/// already exists (it would make the mesh non-manifold) or when either new triangle would turn
-/// against the two old ones (a fold-over).
+/// already exists (it would make the mesh non-manifold), when a new triangle would be degenerate, or
+/// when a new triangle would face against the vertex normal (`mesh.normals`, from the field) of its
+/// non-feature vertex (a fold-over).
 pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
     // Directed edge (from, to) → the triangle that has it. Closed manifold meshes have each edge
     // once in each direction.
@@ -34,11 +35,17 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
         if directed.contains_key(&(c, d)) || directed.contains_key(&(d, c)) {
             continue;
         }
+        // Fold-over test against the field, not the old triangles: the two old triangles straddle
+        // the crease and their normals are a poor reference. Each new triangle lies on one side of
+        // the crease, the side of its one non-feature vertex, and must face the way the field's
+        // normal at that vertex does.
         let p = |v: u32| mesh.positions[v as usize];
-        let old = normal(p(a), p(b), p(c)) + normal(p(b), p(a), p(d));
         let new1 = normal(p(c), p(a), p(d));
         let new2 = normal(p(d), p(b), p(c));
-        if new1.dot(old) <= 0.0 || new2.dot(old) <= 0.0 {
+        if new1 == Vec3::ZERO || new2 == Vec3::ZERO {
+            continue;
+        }
+        if new1.dot(mesh.normals[a as usize]) <= 0.0 || new2.dot(mesh.normals[b as usize]) <= 0.0 {
             continue;
         }
         mesh.triangles[t1 as usize] = [c, a, d];
@@ -76,7 +83,7 @@ mod tests {
                 Vec3::new(1.0, 0.0, 0.0),
                 Vec3::new(0.0, 1.0, 0.0),
             ],
-            normals: vec![],
+            normals: vec![Vec3::Z; 4],
             triangles: vec![[0, 2, 1], [0, 1, 3]],
         };
         let feature = [false, false, true, true];
@@ -87,5 +94,15 @@ mod tests {
             assert!(mesh.face_normal(t).z > 0.0, "orientation kept");
         }
         assert_eq!(flip_toward_features(&mut mesh, &feature), 0, "nothing left to flip");
+    }
+
+    #[test]
+    fn refuses_a_flip_that_would_face_against_the_field() {
+        let mut mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            normals: vec![-Vec3::Z; 4],
+            triangles: vec![[0, 2, 1], [0, 1, 3]],
+        };
+        assert_eq!(flip_toward_features(&mut mesh, &[false, false, true, true]), 0);
     }
 }
