@@ -29,8 +29,10 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
         if c == d || !is_feature[c as usize] || !is_feature[d as usize] {
             continue;
         }
-        if is_feature[a as usize] && is_feature[b as usize] {
-            continue; // already a feature edge
+        if is_feature[a as usize] || is_feature[b as usize] {
+            // Only edges between two crossing vertices are flipped: turning an edge that already ends
+            // at a feature point would join that point's two neighbours on the feature line past it.
+            continue;
         }
         if directed.contains_key(&(c, d)) || directed.contains_key(&(d, c)) {
             continue;

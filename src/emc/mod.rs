@@ -82,6 +82,9 @@ pub struct EmcMesh {
     pub edge_features: usize,
     pub corner_features: usize,
     pub flips: usize,
+    /// Sharp components whose fan around the feature point would fold over (the planes meet
+    /// outside the cell) and were meshed as plain MC instead.
+    pub rejected_features: usize,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -230,7 +233,18 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                     let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    let mut f = Vec3::ZERO;
+                    if kind != FeatureKind::Smooth {
+                        // One bad solve must not throw a spike: the point stays inside its cell.
+                        f = feature_point(&pts, &nrm, kind).clamp(cell_min, cell_max);
+                        // When the planes meet outside the cell, the clamped point can make the fan
+                        // fold over itself; such components stay plain MC.
+                        if !fan_is_valid(f, &pts, &nrm) {
+                            kind = FeatureKind::Smooth;
+                            out.rejected_features += 1;
+                        }
+                    }
                     if kind == FeatureKind::Smooth {
                         if group.contains(&CENTER) {
                             by_edge[CENTER as usize] = out.mesh.positions.len() as u32;
@@ -239,16 +253,10 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                             out.feature_vertex.push(false);
                         }
                         for t in group.chunks_exact(3) {
-                            out.mesh.triangles.push([
-                                by_edge[t[0] as usize],
-                                by_edge[t[1] as usize],
-                                by_edge[t[2] as usize],
-                            ]);
+                            out.mesh.triangles.push([by_edge[t[0] as usize], by_edge[t[1] as usize], by_edge[t[2] as usize]]);
                         }
                         continue;
                     }
-                    // One bad solve must not throw a spike: keep the point inside its cell.
-                    let f = feature_point(&pts, &nrm, kind).clamp(cell_min, cell_max);
                     let fid = out.mesh.positions.len() as u32;
                     out.mesh.positions.push(f);
                     normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
@@ -266,6 +274,17 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
     }
     out.mesh.normals = normals_of_vertex;
     out
+}
+
+/// A fan around `center` is valid when every triangle faces the way the field's normals at its
+/// two polygon vertices do (no fold-over) and none is degenerate.
+fn fan_is_valid(center: Vec3, pts: &[Vec3], nrm: &[Vec3]) -> bool {
+    (0..pts.len()).all(|q| {
+        let r = (q + 1) % pts.len();
+        let n = (pts[q] - center).cross(pts[r] - center);
+        let scale = (pts[q] - center).length() * (pts[r] - center).length();
+        n.length() > 1e-6 * scale && n.dot(nrm[q] + nrm[r]) > 0.0
+    })
 }
 
 /// Mesh edges whose two ends are feature vertices, each once.
