@@ -236,10 +236,16 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                     let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut f = Vec3::ZERO;
                     if kind != FeatureKind::Smooth {
-                        // One bad solve must not throw a spike: the point stays inside its cell.
-                        f = feature_point(&pts, &nrm, kind).clamp(cell_min, cell_max);
-                        // When the planes meet outside the cell, the clamped point can make the fan
-                        // fold over itself; such components stay plain MC.
+                        // One bad solve must not throw a spike: the point stays inside its cell, or
+                        // (where the planes meet just outside it and clamping would fold the fan)
+                        // within half a cell of it.
+                        let solved = feature_point(&pts, &nrm, kind);
+                        f = solved.clamp(cell_min, cell_max);
+                        if !fan_is_valid(f, &pts, &nrm) {
+                            let margin = grid.spacing * 0.5;
+                            f = solved.clamp(cell_min - margin, cell_max + margin);
+                        }
+                        // Where neither works, the component stays plain MC.
                         if !fan_is_valid(f, &pts, &nrm) {
                             kind = FeatureKind::Smooth;
                             out.rejected_features += 1;
