@@ -105,12 +105,34 @@ pub struct Output {
     pub stats: Stats,
 }
 
-fn from_emc(
-    out: EmcMesh,
-    timings: crate::emc::EmcTimings,
-) -> (Mesh, Vec<[u32; 2]>, Vec<(String, f64)>, [usize; 3]) {
-    let counts = [out.edge_features, out.corner_features, out.flips];
-    (out.mesh, out.feature_edges, timings.phases(), counts)
+/// What a method hands back before analysis.
+struct Meshed {
+    mesh: Mesh,
+    feature_edges: Vec<[u32; 2]>,
+    phases: Vec<(String, f64)>,
+    /// Edge features, corner features, flips (EMC).
+    feature_counts: [usize; 3],
+}
+
+impl Meshed {
+    fn plain(mesh: Mesh, phases: Vec<(String, f64)>) -> Meshed {
+        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3] }
+    }
+
+    fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
+        Meshed {
+            feature_counts: [out.edge_features, out.corner_features, out.flips],
+            phases: timings.phases(),
+            mesh: out.mesh,
+            feature_edges: out.feature_edges,
+        }
+    }
+
+    fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
+        let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
+        stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
+        Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
+    }
 }
 
 /// Meshes a field over `bounds` (unless the request overrides them).
@@ -118,42 +140,37 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
     let (min, max) = request.bounds.unwrap_or(bounds);
     let grid = Grid::with_resolution(min, max, request.res)?;
     grid.check_size(request.max_cells)?;
-    let (mesh, feature_edges, phases, counts) = match request.method {
+    let meshed = match request.method {
         Method::Mc => {
             let (mesh, timings) = mc::mesh_field(field, &grid, &request.mc_options())?;
-            (mesh, vec![], timings.phases(), [0; 3])
+            Meshed::plain(mesh, timings.phases())
         }
         Method::Emc => {
             let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
-            from_emc(out, timings)
+            Meshed::from_emc(out, timings)
         }
     };
     let shifted = Shifted { field, iso: request.iso };
-    let mut stats =
-        stats::compute(request.method.name(), request.res, &mesh, &shifted, phases, request.analysis);
-    stats.set_feature_counts(feature_edges.len(), counts);
-    Ok(Output { mesh, feature_edges, stats })
+    Ok(meshed.analyse(request.method, request.res, &shifted, request.analysis))
 }
 
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
 /// the samples stands in for the true surface in the error statistics.
 pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Output, Error> {
-    let (mesh, feature_edges, phases, counts) = match request.method {
+    let meshed = match request.method {
         Method::Mc => {
             let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
-            (mesh, vec![], timings.phases(), [0; 3])
+            Meshed::plain(mesh, timings.phases())
         }
         Method::Emc => {
             let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
-            from_emc(out, timings)
+            Meshed::from_emc(out, timings)
         }
     };
     let field = SampledField { grid: *grid, values };
     let shifted = Shifted { field: &field, iso: request.iso };
     let res = grid.cells.iter().copied().max().unwrap_or(0);
-    let mut stats = stats::compute(request.method.name(), res, &mesh, &shifted, phases, request.analysis);
-    stats.set_feature_counts(feature_edges.len(), counts);
-    Ok(Output { mesh, feature_edges, stats })
+    Ok(meshed.analyse(request.method, res, &shifted, request.analysis))
 }
 
 /// The field minus the iso-level, so "the surface" is always the zero set for the analysis.

@@ -101,7 +101,12 @@ mod tests {
     #[test]
     fn refuses_a_flip_that_would_face_against_the_field() {
         let mut mesh = Mesh {
-            positions: vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
             normals: vec![-Vec3::Z; 4],
             triangles: vec![[0, 2, 1], [0, 1, 3]],
         };

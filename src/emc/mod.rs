@@ -259,7 +259,11 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                             out.feature_vertex.push(false);
                         }
                         for t in group.chunks_exact(3) {
-                            out.mesh.triangles.push([by_edge[t[0] as usize], by_edge[t[1] as usize], by_edge[t[2] as usize]]);
+                            out.mesh.triangles.push([
+                                by_edge[t[0] as usize],
+                                by_edge[t[1] as usize],
+                                by_edge[t[2] as usize],
+                            ]);
                         }
                         continue;
                     }
