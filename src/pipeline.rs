@@ -90,6 +90,7 @@ impl Request {
             phi_corner: self.phi_corner,
             directed: self.directed,
             flip_edges: true,
+            crust: true,
             topology: self.topology,
             max_cells: self.max_cells,
         }
@@ -112,16 +113,19 @@ struct Meshed {
     phases: Vec<(String, f64)>,
     /// Edge features, corner features, flips (EMC).
     feature_counts: [usize; 3],
+    /// Points evaluated and grid points (EMC).
+    evaluations: Option<(usize, usize)>,
 }
 
 impl Meshed {
     fn plain(mesh: Mesh, phases: Vec<(String, f64)>) -> Meshed {
-        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3] }
+        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3], evaluations: None }
     }
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
         Meshed {
             feature_counts: [out.edge_features, out.corner_features, out.flips],
+            evaluations: Some((out.points_evaluated, out.grid_points)),
             phases: timings.phases(),
             mesh: out.mesh,
             feature_edges: out.feature_edges,
@@ -131,6 +135,8 @@ impl Meshed {
     fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
         let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
+        stats.points_evaluated = self.evaluations.map(|e| e.0);
+        stats.grid_points = self.evaluations.map(|e| e.1);
         Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
     }
 }

@@ -6,6 +6,7 @@
 //! The topology is exactly plain MC's on the same grid (same polygons from [`crate::tables`]), so
 //! EMC inherits its watertightness; only the geometry inside each cell changes.
 
+pub mod crust;
 pub mod edges;
 pub mod feature;
 pub mod flip;
@@ -37,6 +38,9 @@ pub struct EmcOptions {
     pub flip_edges: bool,
     pub topology: Topology,
     pub max_cells: u64,
+    /// Evaluate the field only where its interval bounds say the surface may be (§2's crust);
+    /// the output is identical. Fields without interval bounds are sampled everywhere.
+    pub crust: bool,
 }
 
 impl Default for EmcOptions {
@@ -49,6 +53,7 @@ impl Default for EmcOptions {
             flip_edges: true,
             topology: Topology::Fixed,
             max_cells: DEFAULT_MAX_CELLS,
+            crust: true,
         }
     }
 }
@@ -82,6 +87,9 @@ pub struct EmcMesh {
     pub edge_features: usize,
     pub corner_features: usize,
     pub flips: usize,
+    /// Grid points where the field was evaluated, and how many the grid has.
+    pub points_evaluated: usize,
+    pub grid_points: usize,
     /// Sharp components whose fan around the feature point would fold over (the planes meet
     /// outside the cell) and were meshed as plain MC instead.
     pub rejected_features: usize,
@@ -113,9 +121,14 @@ pub fn mesh_field(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let values = sample_grid(field, grid)?;
+    let crust = if options.crust { crust::sample_crust(field, grid, options.iso).transpose()? } else { None };
+    let (values, evaluated) = match crust {
+        Some(c) => (c.values, c.evaluated),
+        None => (sample_grid(field, grid)?, grid.point_count()),
+    };
     let sample_ms = ms_since(t0);
-    let (mesh, mut timings) = run(&values, grid, options, Some(field))?;
+    let (mut mesh, mut timings) = run(&values, grid, options, Some(field))?;
+    mesh.points_evaluated = evaluated;
     timings.sample_ms = sample_ms;
     Ok((mesh, timings))
 }
@@ -129,7 +142,9 @@ pub fn mesh_samples(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     check_finite(values, grid)?;
-    run(values, grid, options, None)
+    let (mut mesh, timings) = run(values, grid, options, None)?;
+    mesh.points_evaluated = grid.point_count();
+    Ok((mesh, timings))
 }
 
 fn run(
@@ -141,6 +156,7 @@ fn run(
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
     let mut out = extract(values, grid, options, field);
+    out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
     if options.flip_edges {
