@@ -20,7 +20,7 @@ use crate::tables::{
     polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
     CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS,
 };
-use edges::{edge_root, field_normal};
+use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, feature_point, FeatureKind};
 use glam::Vec3;
 use web_time::Instant;
@@ -127,7 +127,8 @@ pub fn mesh_field(
         None => (sample_grid(field, grid)?, grid.point_count()),
     };
     let sample_ms = ms_since(t0);
-    let (mut mesh, mut timings) = run(&values, grid, options, Some(field))?;
+    let sampler = FieldRoots { field, iso: options.iso, directed: options.directed, h: grid.cell_size() };
+    let (mut mesh, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;
     mesh.points_evaluated = evaluated;
     timings.sample_ms = sample_ms;
     Ok((mesh, timings))
@@ -142,20 +143,27 @@ pub fn mesh_samples(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     check_finite(values, grid)?;
-    let (mut mesh, timings) = run(values, grid, options, None)?;
+    let (mut mesh, timings) =
+        mesh_with_sampler(values, grid, options, &SampleInterpolation { values, grid })?;
     mesh.points_evaluated = grid.point_count();
     Ok((mesh, timings))
 }
 
-fn run(
+/// EMC from grid values (their signs pick the MC case, `value - iso < 0` inside) and any source of
+/// edge crossings: the entry point for inputs that are neither fields nor plain samples, such as
+/// triangle meshes (ray casting) and point clouds (tangent planes).
+pub fn mesh_with_sampler(
     values: &[f32],
     grid: &Grid,
     options: &EmcOptions,
-    field: Option<&dyn Field>,
+    sampler: &dyn EdgeSampler,
 ) -> Result<(EmcMesh, EmcTimings), Error> {
+    options.validate()?;
+    grid.check_size(options.max_cells)?;
+    check_finite(values, grid)?;
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
-    let mut out = extract(values, grid, options, field);
+    let mut out = extract(values, grid, options, sampler);
     out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
@@ -167,35 +175,24 @@ fn run(
     Ok((out, timings))
 }
 
-/// Edge crossing: position and unit normal.
+/// Where the surface crosses cell edge `e` and its unit normal there, from `sampler`.
 fn crossing(
-    values: &[f32],
     grid: &Grid,
-    options: &EmcOptions,
-    field: Option<&dyn Field>,
+    sampler: &dyn EdgeSampler,
     cell: [usize; 3],
     e: usize,
     d: &[f32; 8],
 ) -> (Vec3, Vec3) {
     let [a, b] = EDGES[e];
-    let (da, db) = (d[a as usize], d[b as usize]);
     let ca = CORNERS[a as usize];
     let pa = grid.position(cell[0] + ca[0], cell[1] + ca[1], cell[2] + ca[2]);
     let mut step = Vec3::ZERO;
     step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
-    let t = match field {
-        Some(f) if options.directed => edge_root(f, options.iso, pa, pa + step, da, db),
-        _ => (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION),
-    };
-    let p = pa + step * t;
-    let n = match field {
-        Some(f) => field_normal(f, p, grid.cell_size() * 1e-3),
-        None => crate::mc::sample_gradient(values, grid, p).normalize_or_zero(),
-    };
-    (p, n)
+    let (t, n) = sampler.crossing(pa, pa + step, d[a as usize], d[b as usize]);
+    (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
 }
 
-fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn Field>) -> EmcMesh {
+fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn EdgeSampler) -> EmcMesh {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -238,7 +235,7 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                     for &e in poly {
                         let slot = cache.slot(i, j, e as usize);
                         if *slot == NONE {
-                            let (p, n) = crossing(values, grid, options, field, [i, j, k], e as usize, &d);
+                            let (p, n) = crossing(grid, sampler, [i, j, k], e as usize, &d);
                             *slot = out.mesh.positions.len() as u32;
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
