@@ -10,6 +10,9 @@ use crate::error::Error;
 use crate::field::Field;
 use crate::grid::Grid;
 
+/// Boxes at most this many cells on a side are sampled without further bounding.
+const LEAF_CELLS: usize = 4;
+
 /// Samples for a whole grid, of which only the crust was evaluated.
 pub struct CrustSamples {
     pub values: Vec<f32>,
@@ -59,7 +62,9 @@ impl Traversal<'_> {
         }
         let sizes = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
         let axis = (0..3).max_by_key(|&a| sizes[a]).expect("three axes");
-        if sizes[axis] == 1 {
+        // Below a few cells a box is cheaper to sample densely (batched, vectorised evaluation)
+        // than to keep bounding (each interval query costs about as much as a dozen points).
+        if sizes[axis] <= LEAF_CELLS {
             self.mark(lo, hi);
             return;
         }
