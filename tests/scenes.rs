@@ -6,6 +6,7 @@ mod common;
 use common::assert_watertight;
 use isoforge::expr::{self, Program};
 use isoforge::mc::{self, McOptions};
+use isoforge::mesh::analysis;
 use isoforge::{scenes, Grid, Vec3};
 
 #[cfg(target_arch = "wasm32")]
@@ -25,6 +26,10 @@ fn every_scene_meshes_to_a_closed_manifold_with_its_euler_characteristic() {
         let (mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
         // Closed, manifold, oriented outward, no degenerate triangles, no self-intersections.
         let topo = assert_watertight(&mesh, name);
+        // Every point of the mesh walks to the surface within a cell, along exact gradients.
+        let error = analysis::surface_error(&mesh, scene.field.as_ref());
+        assert_eq!(error.unconverged, 0, "{name}: projections onto the surface did not settle");
+        assert!(error.dist_max < grid.cell_size() as f64, "{name}: {} off the surface", error.dist_max);
         if SUB_CELL.contains(&name) {
             continue;
         }
