@@ -2,30 +2,21 @@
 // page served on localhost. Run by scripts/test.sh after the wasm package is built.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { chromium } from 'playwright-core';
+import { serve, launch } from '../../scripts/browser.mjs';
 
-const PORT = 8000 + Math.floor(Math.random() * 1000);
-const URL = `http://127.0.0.1:${PORT}/`;
 let server;
 let browser;
+let URL;
 
 before(async () => {
-  server = spawn(process.execPath, ['scripts/serve.mjs', 'www', String(PORT)], { stdio: ['ignore', 'pipe', 'inherit'] });
-  await new Promise((resolve, reject) => {
-    server.stdout.once('data', resolve);
-    server.once('exit', (code) => reject(new Error(`server exited with ${code}`)));
-  });
-  browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-  });
+  server = await serve('www');
+  URL = server.url;
+  browser = await launch();
 });
 
 after(async () => {
   await browser?.close();
-  server?.kill();
+  server?.close();
 });
 
 async function openDemo() {
