@@ -13,10 +13,13 @@ use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mesh::Mesh;
 use crate::tables::{
-    triangle_table, triangle_table_with_faces, CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
+    polygon_table_with_faces, triangle_table, triangle_table_with_faces, triangulate_polygon, CellTriangles,
+    CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
 };
 use glam::Vec3;
 use web_time::Instant;
+
+pub mod interior;
 
 /// Smallest distance, as a fraction of the edge, between a vertex and the edge's end points.
 pub const MIN_EDGE_FRACTION: f32 = 1e-3;
@@ -27,8 +30,11 @@ pub enum Topology {
     /// Inside corners on an ambiguous face are always separated: one fixed table, fastest.
     #[default]
     Fixed,
-    /// The asymptotic decider picks, per face, the connectivity of the bilinear interpolant on that
-    /// face, so surfaces match the trilinear interpolant on every cell face.
+    /// The topology of the trilinear interpolant, as Marching Cubes 33 means it: the asymptotic
+    /// decider picks, per face, the connectivity of the bilinear interpolant on that face, and the
+    /// interior test ([`interior`]) adds the tunnels the faces cannot see. One exception keeps the
+    /// mesh manifold: two tunnels pressed against one face from both sides are left out (see
+    /// `tunnels_meet`). Plain MC only; EMC takes the face decisions alone.
     Trilinear,
 }
 
@@ -205,41 +211,145 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
                 if case == 0 || case == 255 {
                     continue;
                 }
+                let mut cell = Cell { grid, ijk: [i, j, k], d: &d, ids: [NONE; 13] };
                 let tris: &CellTriangles = match options.topology {
                     Topology::Fixed => &fixed[case as usize],
                     Topology::Trilinear => {
-                        &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize]
+                        let joined = joined_faces(case, &d);
+                        let joins = interior::interior_joins(case, joined, &d);
+                        if !joins.is_empty() && !tunnels_meet(values, grid, iso, [i, j, k], case) {
+                            cell.emit_with_tunnels(case, joined, &joins, &mut cache, &mut mesh);
+                            continue;
+                        }
+                        &with_faces[(case as usize) << 6 | joined as usize]
                     }
                 };
-                let mut ids = [NONE; 13];
                 let mut at = 0;
                 for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
                     let group = &tris.edges[3 * at..3 * (at + count as usize)];
                     at += count as usize;
-                    for &e in group.iter().filter(|&&e| e != CENTER) {
-                        let e = e as usize;
-                        if ids[e] != NONE {
-                            continue;
-                        }
-                        let slot = cache.slot(i, j, e);
-                        if *slot == NONE {
-                            *slot = mesh.positions.len() as u32;
-                            mesh.positions.push(edge_point(grid, [i, j, k], e, &d));
-                        }
-                        ids[e] = *slot;
-                    }
-                    if group.contains(&CENTER) {
-                        ids[CENTER as usize] = mesh.positions.len() as u32;
-                        mesh.positions.push(polygon_center(&mesh.positions, group, &ids));
-                    }
-                    for t in group.chunks_exact(3) {
-                        mesh.triangles.push([ids[t[0] as usize], ids[t[1] as usize], ids[t[2] as usize]]);
-                    }
+                    cell.emit_polygon(group, &mut cache, &mut mesh);
                 }
             }
         }
     }
     Ok(mesh)
+}
+
+/// The signed corner values of cell `ijk`, in [`CORNERS`] order.
+fn cell_values(values: &[f32], grid: &Grid, iso: f32, ijk: [usize; 3]) -> [f32; 8] {
+    std::array::from_fn(|c| {
+        let [a, b, e] = CORNERS[c];
+        values[grid.index(ijk[0] + a, ijk[1] + b, ijk[2] + e)] - iso
+    })
+}
+
+/// Whether a neighbour across one of the ambiguous faces of cell `ijk` also has an interior join.
+/// Two tunnels pressed against the same face from both sides (the face's saddle barely on the other
+/// side of the level) would both lie in that face, and their tubes would share edges: then both
+/// cells keep their faces' answer instead. The rule is symmetric, so the two cells agree.
+fn tunnels_meet(values: &[f32], grid: &Grid, iso: f32, ijk: [usize; 3], case: u8) -> bool {
+    FACES.iter().enumerate().any(|(f, corners)| {
+        if !crate::tables::face_is_ambiguous(case, f) {
+            return false;
+        }
+        // The face's fixed axis and side, read off its corners.
+        let axis = (0..3)
+            .find(|&a| corners.iter().all(|&c| CORNERS[c as usize][a] == CORNERS[corners[0] as usize][a]));
+        let Some(axis) = axis else { return false };
+        let mut other = ijk;
+        if CORNERS[corners[0] as usize][axis] == 1 {
+            if ijk[axis] + 1 >= grid.cells[axis] {
+                return false;
+            }
+            other[axis] += 1;
+        } else {
+            if ijk[axis] == 0 {
+                return false;
+            }
+            other[axis] -= 1;
+        }
+        let d = cell_values(values, grid, iso, other);
+        let case = d.iter().enumerate().fold(0u8, |m, (c, &v)| m | ((v < 0.0) as u8) << c);
+        !interior::interior_joins(case, joined_faces(case, &d), &d).is_empty()
+    })
+}
+
+/// One cell being emitted: where it is, its signed corner values, and the mesh ids of its edge
+/// vertices found so far (index [`CENTER`] for a polygon's centre vertex).
+struct Cell<'a> {
+    grid: &'a Grid,
+    ijk: [usize; 3],
+    d: &'a [f32; 8],
+    ids: [u32; 13],
+}
+
+impl Cell<'_> {
+    /// The shared vertex on cell edge `e`, created by the first cell that needs it.
+    fn vertex(&mut self, e: u8, cache: &mut EdgeCache, mesh: &mut Mesh) -> u32 {
+        let e = e as usize;
+        if self.ids[e] == NONE {
+            let slot = cache.slot(self.ijk[0], self.ijk[1], e);
+            if *slot == NONE {
+                *slot = mesh.positions.len() as u32;
+                mesh.positions.push(edge_point(self.grid, self.ijk, e, self.d));
+            }
+            self.ids[e] = *slot;
+        }
+        self.ids[e]
+    }
+
+    /// The triangles of one polygon, as edge ids (and [`CENTER`]) in table form.
+    fn emit_polygon(&mut self, group: &[u8], cache: &mut EdgeCache, mesh: &mut Mesh) {
+        for &e in group.iter().filter(|&&e| e != CENTER) {
+            self.vertex(e, cache, mesh);
+        }
+        if group.contains(&CENTER) {
+            self.ids[CENTER as usize] = mesh.positions.len() as u32;
+            mesh.positions.push(polygon_center(&mesh.positions, group, &self.ids));
+        }
+        for t in group.chunks_exact(3) {
+            mesh.triangles.push([t[0], t[1], t[2]].map(|e| self.ids[e as usize]));
+        }
+    }
+
+    /// A cell whose interior joins what its faces keep apart: the joined polygons become tubes.
+    fn emit_with_tunnels(
+        &mut self,
+        case: u8,
+        joined: u8,
+        joins: &[(u8, u8, bool)],
+        cache: &mut EdgeCache,
+        mesh: &mut Mesh,
+    ) {
+        let polygons = &polygon_table_with_faces()[(case as usize) << 6 | joined as usize];
+        let (rest, tubes) = interior::tunnels(case, joined, polygons, joins);
+        let all: Vec<&[u8]> = polygons.iter().collect();
+        for k in rest {
+            let group: Vec<u8> = triangulate_polygon(all[k]).concat();
+            self.emit_polygon(&group, cache, mesh);
+        }
+        for (a, b) in tubes {
+            for e in all[a].iter().chain(all[b]) {
+                self.vertex(*e, cache, mesh);
+            }
+            let positions = &mesh.positions;
+            let ids = self.ids;
+            let area = |t: [u8; 3]| {
+                let [p, q, r] = t.map(|e| positions[ids[e as usize] as usize]);
+                (q - p).cross(r - p).length() as f64
+            };
+            match interior::tube(all[a], all[b], |_, _| true, area) {
+                Some(band) => mesh.triangles.extend(band.iter().map(|t| t.map(|e| ids[e as usize]))),
+                None => {
+                    for k in [a, b] {
+                        let group: Vec<u8> = triangulate_polygon(all[k]).concat();
+                        self.emit_polygon(&group, cache, mesh);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.
