@@ -17,6 +17,12 @@ pub trait Field {
         None
     }
 
+    /// Conservative bounds `(lo, hi)` of the value over the box `[lo, hi]`, where the field can give
+    /// them (compiled expressions can): octrees use them to skip space the surface cannot reach.
+    fn interval(&self, _lo: Vec3, _hi: Vec3) -> Option<(f32, f32)> {
+        None
+    }
+
     /// Values at many points at once. Evaluators that vectorise override this; grids call it per row.
     fn values(&self, points: &[Vec3], out: &mut [f32]) {
         for (p, o) in points.iter().zip(out.iter_mut()) {

@@ -16,6 +16,10 @@ impl Field for Program {
     fn values(&self, points: &[Vec3], out: &mut [f32]) {
         self.eval_many(points, out);
     }
+
+    fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
+        Some(self.eval_interval(lo, hi))
+    }
 }
 
 #[cfg(test)]
