@@ -24,8 +24,7 @@
 
 use super::dual::CellRef;
 use super::octree::{Kind, Octree, NONE};
-use super::qef::Solution;
-use crate::field::Field;
+use crate::field::{finite_difference_gradient, Field};
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -34,16 +33,45 @@ pub const SHRINK: f32 = 1e-4;
 
 /// Places the vertex of every sampled leaf that has none yet.
 pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
+    let iso = tree.params.iso;
     for n in 0..tree.nodes.len() as u32 {
         let node = tree.nodes[n as usize];
         if node.kind != Kind::Leaf || node.has_vertex {
             continue;
         }
         let (lo, hi) = shrunk(tree, n);
-        let allow = sliver_elimination && node.straddles && !node.keep_free;
-        let (solution, on_surface) = solve(tree, n, lo, hi, allow);
-        let vertex = solution.position.as_vec3();
-        let value = field.value(vertex) - tree.params.iso;
+        if node.centred {
+            let centre = (lo + hi) * 0.5;
+            let node = &mut tree.nodes[n as usize];
+            (node.vertex, node.value, node.has_vertex, node.on_surface) =
+                (centre, field.value(centre) - iso, true, false);
+            continue;
+        }
+        let linear = node.straddles && tree.qefs[node.qef as usize].rank() == 1;
+        let mut vertex = free_minimiser(tree, n, lo, hi);
+        let mut value = field.value(vertex) - iso;
+        let mut on_surface = false;
+        if sliver_elimination && linear && !node.keep_free {
+            let restricted = tree.qefs[node.qef as usize].minimise_in_box(lo, hi, Some(0.0));
+            let p = restricted.position.as_vec3();
+            let v = field.value(p) - iso;
+            if restricted.rms <= tree.params.tolerance as f64 && v.abs() <= tree.params.tolerance {
+                // On the surface, counted as inside (see the module docs).
+                (vertex, value, on_surface) = (p, v.min(-f32::MIN_POSITIVE), true);
+            }
+        }
+        if linear && !on_surface {
+            // Move the vertex a quarter cell into the solid along the gradient.
+            let h = (hi - lo).max_element();
+            let g =
+                field.gradient(vertex).unwrap_or_else(|| finite_difference_gradient(field, vertex, h * 1e-3));
+            let slope = g.length();
+            if slope > 1e-12 {
+                let target = -0.25 * h * slope;
+                vertex = (vertex - g * ((value - target) / (slope * slope))).clamp(lo, hi);
+                value = field.value(vertex) - iso;
+            }
+        }
         let node = &mut tree.nodes[n as usize];
         node.vertex = vertex;
         node.value = value;
@@ -53,16 +81,12 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
 }
 
 /// Leaves whose vertex sliver elimination moved onto the surface but which share a mixed dual
-/// cell with a feature leaf (QEF rank 2 or more: a crease or corner of the function). Near a
-/// feature the vertices around it must keep the function's sign pattern, or the feature is cut
-/// off (a chamfer across a cube's edge); these fall back to the free minimiser.
+/// cell with a feature leaf (straddling, QEF rank two or more: a crease, a corner, a curved or thin
+/// part). They fall back to the free (biased) vertex.
 pub fn near_features(tree: &Octree, refs: &[[CellRef; 8]]) -> Vec<u32> {
     let is_feature = |n: u32| {
         let node = &tree.nodes[n as usize];
-        node.kind == Kind::Leaf
-            && node.straddles
-            && node.value.abs() <= tree.params.tolerance
-            && tree.qefs[node.qef as usize].rank() >= 2
+        node.kind == Kind::Leaf && node.straddles && tree.qefs[node.qef as usize].rank() >= 2
     };
     let mut out: Vec<u32> = refs
         .iter()
@@ -81,18 +105,10 @@ fn shrunk(tree: &Octree, n: u32) -> (Vec3, Vec3) {
     (lo + margin, hi - margin)
 }
 
-/// The free minimiser, or (when allowed, the QEF is rank one and the restricted residual within
-/// the tolerance) the minimiser on `w = 0`; and whether it is the latter.
-fn solve(tree: &Octree, n: u32, lo: Vec3, hi: Vec3, restricted: bool) -> (Solution, bool) {
+/// The minimiser of the leaf's QEF in the box (the leaf, shrunk, or one of its boundary faces).
+fn free_minimiser(tree: &Octree, n: u32, lo: Vec3, hi: Vec3) -> Vec3 {
     let node = &tree.nodes[n as usize];
-    let qef = &tree.qefs[node.qef as usize];
-    if restricted && qef.rank() == 1 {
-        let on_surface = qef.minimise_in_box(lo, hi, Some(0.0));
-        if on_surface.rms <= tree.params.tolerance as f64 {
-            return (on_surface, true);
-        }
-    }
-    (qef.minimise_in_box(lo, hi, None), false)
+    tree.qefs[node.qef as usize].minimise_in_box(lo, hi, None).position.as_vec3().clamp(lo, hi)
 }
 
 /// The dual vertices met so far: position and `f - iso`, numbered densely.
@@ -156,7 +172,8 @@ fn boundary_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) 
     let node = &tree.nodes[r.node as usize];
     let p = match node.kind {
         Kind::Pruned => (lo + hi) * 0.5,
-        _ => solve(tree, r.node, lo, hi, false).0.position.as_vec3().clamp(lo, hi),
+        _ if node.centred => (lo + hi) * 0.5,
+        _ => free_minimiser(tree, r.node, lo, hi),
     };
     (p, field.value(p) - tree.params.iso)
 }

@@ -38,6 +38,14 @@ use glam::Vec3;
 use octree::{Octree, Params, MAX_DEPTH_LIMIT};
 use web_time::Instant;
 
+/// The root cube is the bounds' cube grown by this factor and placed slightly off-centre (a fraction
+/// [`ROOT_BELOW_CENTRE`] of it below the bounds' centre), so that the round coordinates CSG models
+/// are written in (0, ±0.5, ±0.25, …) do not fall on cell faces at any depth. A thin wall lying in a
+/// cell face is seen from one side only by each of the two cells sharing it: both fit one plane,
+/// both vertices land outside the wall, and the wall is lost until refinement resolves it.
+pub const ROOT_GROWTH: f32 = 1.05;
+pub const ROOT_BELOW_CENTRE: f32 = 0.49;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DmcOptions {
     pub iso: f32,
@@ -139,10 +147,11 @@ pub fn mesh_field(
 ) -> Result<(Mesh, DmcStats), Error> {
     options.validate()?;
     Grid::new(min, max, [1, 1, 1])?;
-    let size = (max - min).max_element();
+    let longest = (max - min).max_element();
+    let size = longest * ROOT_GROWTH;
     let params = Params {
         iso: options.iso,
-        tolerance: options.tolerance * size,
+        tolerance: options.tolerance * longest,
         max_depth: options.max_depth,
         samples_per_cell: options.samples_per_cell,
         prune: options.prune,
@@ -150,7 +159,8 @@ pub fn mesh_field(
     };
     let mut stats = DmcStats::default();
     let t = Instant::now();
-    let mut tree = Octree::build(field, (min + max) * 0.5 - Vec3::splat(size * 0.5), size, params)?;
+    let mut tree =
+        Octree::build(field, (min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)?;
     stats.octree_ms += ms_since(t);
     let mut contour = loop {
         stats.rounds += 1;
@@ -193,8 +203,13 @@ pub fn mesh_field(
         }
 
         let t = Instant::now();
-        let contour = contour::contour(&ids, &vertices, field, options.iso);
+        let mut contour = contour::contour(&ids, &vertices, field, options.iso);
         stats.contour_ms += ms_since(t);
+
+        let centre = refine::to_centre(&tree, field, &refs, &contour);
+        if centre_leaves(&mut tree, &centre) {
+            continue;
+        }
 
         let t = Instant::now();
         let split = refine::to_refine(&tree, field, &refs, &ids, &vertices.values, &contour);
@@ -202,20 +217,39 @@ pub fn mesh_field(
             tree.refine(field, n)?;
         }
         stats.octree_ms += ms_since(t);
-        if split.is_empty() {
-            break (contour, vertices);
+        if !split.is_empty() {
+            continue;
+        }
+
+        let t = Instant::now();
+        if options.sliver_elimination {
+            stats.slivers_removed =
+                slivers::collapse(&mut contour, &vertices, field, options.iso, params.tolerance);
+        }
+        let pairs = crate::mesh::analysis::self_intersecting_pairs(&contour.mesh);
+        stats.contour_ms += ms_since(t);
+        let tangled = refine::tangled(&tree, &refs, &contour, &pairs);
+        if !centre_leaves(&mut tree, &tangled) {
+            break contour;
         }
     };
     let t = Instant::now();
-    if options.sliver_elimination {
-        stats.slivers_removed =
-            slivers::collapse(&mut contour.0, &contour.1, field, options.iso, params.tolerance);
-    }
-    let mut mesh = std::mem::take(&mut contour.0.mesh);
+    let mut mesh = std::mem::take(&mut contour.mesh);
     contour::field_normals(&mut mesh, field, tree.cell_size(options.max_depth) * 1e-2);
     stats.contour_ms += ms_since(t);
     stats.octree_leaves = tree.leaf_count() as usize;
     stats.pruned_leaves =
         tree.leaves().filter(|&n| tree.nodes[n as usize].kind == octree::Kind::Pruned).count();
     Ok((mesh, stats))
+}
+
+/// Puts the vertices of `leaves` at their cells' centres (rules 4 and 5 of `refine`); whether any
+/// changed.
+fn centre_leaves(tree: &mut Octree, leaves: &[u32]) -> bool {
+    for &n in leaves {
+        let node = &mut tree.nodes[n as usize];
+        node.centred = true;
+        node.has_vertex = false;
+    }
+    !leaves.is_empty()
 }

@@ -47,6 +47,8 @@ pub struct Node {
     pub on_surface: bool,
     /// Sliver elimination must not move this vertex: a neighbour holds a feature.
     pub keep_free: bool,
+    /// The vertex stays at the cell's centre: feature placement folded the contour here.
+    pub centred: bool,
     /// The dual vertex (set by feature isolation) and `f - iso` there.
     pub vertex: Vec3,
     pub value: f32,
@@ -89,6 +91,7 @@ impl Octree {
                 straddles: false,
                 on_surface: false,
                 keep_free: false,
+                centred: false,
                 vertex: Vec3::ZERO,
                 value: 0.0,
                 has_vertex: false,
@@ -196,6 +199,7 @@ impl Octree {
                 straddles: false,
                 on_surface: false,
                 keep_free: false,
+                centred: false,
                 vertex: Vec3::ZERO,
                 value: 0.0,
                 has_vertex: false,

@@ -98,3 +98,41 @@ pub fn to_refine(
     out.dedup();
     out
 }
+
+/// Rule 4: sampled leaves of dual cells whose contour folds over (a triangle facing away from the
+/// field's gradient by more than 90°). Vertices far from their cells' centres can fold a dual cell;
+/// these leaves fall back to their centres, where the dual grid is regular and Marching Cubes
+/// cannot fold (the paper's §5 variant), at the price of sharpness there.
+pub fn to_centre(tree: &Octree, field: &dyn Field, refs: &[[CellRef; 8]], contour: &Contour) -> Vec<u32> {
+    let h = tree.cell_size(tree.params.max_depth) * 1e-2;
+    let mut out: Vec<u32> = (0..contour.mesh.triangle_count())
+        .filter(|&t| {
+            let [a, b, c] = contour.mesh.corners(t);
+            let normal = (b - a).cross(c - a);
+            let p = (a + b + c) / 3.0;
+            let g =
+                field.gradient(p).unwrap_or_else(|| crate::field::finite_difference_gradient(field, p, h));
+            normal.dot(g) < 0.0
+        })
+        .flat_map(|t| refs[contour.cell_of_triangle[t] as usize].iter().map(|r| r.node))
+        .filter(|&n| tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred)
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Rule 5: sampled, not yet centred leaves of the dual cells that made intersecting triangles (the
+/// final check, after sliver collapse). Folds that rule 4 misses — two sheets of the contour
+/// crossing where several features meet in one cell — are undone the same way.
+pub fn tangled(tree: &Octree, refs: &[[CellRef; 8]], contour: &Contour, pairs: &[[u32; 2]]) -> Vec<u32> {
+    let mut out: Vec<u32> = pairs
+        .iter()
+        .flatten()
+        .flat_map(|&t| refs[contour.cell_of_triangle[t as usize] as usize].iter().map(|r| r.node))
+        .filter(|&n| tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred)
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
