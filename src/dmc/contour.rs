@@ -33,7 +33,7 @@ pub struct Crossing {
     pub t: f32,
 }
 
-#[derive(Debug, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct Contour {
     pub mesh: Mesh,
     /// Per mesh vertex: the dual edge it lies on.

@@ -3,24 +3,30 @@
 //! [`super::dual`]), found by the same QEF restricted to the leaf's face, edge or corner on the root's
 //! boundary.
 //!
-//! Choices:
+//! Choices (each measured; see the README's DMC notes):
 //! - The vertex is kept in the leaf shrunk by [`SHRINK`] of its side, so two leaves never share a
 //!   vertex position (a feature exactly on a cell face would otherwise give both cells the same
 //!   point, and the mesh two coincident vertices). Boundary vertices keep their pinned coordinate.
-//! - The stored value is `f(vertex) - iso`, evaluated, not the QEF's estimate: the sign of a vertex
-//!   is then the sign of the field at a point of its leaf, which the pruning argument relies on.
-//! - Sliver elimination (§4): where the cell straddles the iso-level, its QEF has rank one (the
-//!   function is locally linear there) and the QEF restricted to `w = 0` has a residual within the
-//!   tolerance, the restricted minimiser (a point on the estimated surface) is used instead. The
-//!   crossings around such a vertex all land next to it and [`super::slivers`] merges them into it.
-//!   Measured on a ball this halves the triangles and lifts the smallest angle from ~3° to ~25°.
-//! - Except next to a feature on the surface ([`near_features`]): a vertex with a value of about
-//!   zero is harmless while its neighbours have definite signs (its crossings then all land on it),
-//!   but if the vertices around a cube's corner all sat on the surface their signs would be noise
-//!   and the corner would be cut off. Leaves sharing a mixed dual cell with a surface feature (QEF
-//!   rank two or more, vertex on the surface) keep the free minimiser.
+//! - The stored value is `f(vertex) - iso`, evaluated, not the QEF's estimate, so the sign of a
+//!   vertex is the sign of the field at a point of its leaf (the pruning argument relies on it).
+//! - **Signs around features.** Dual Marching Cubes sees the surface only through the signs of the
+//!   dual vertices. A vertex on a sharp edge has value 0 (outside, by the crate's rule), and so do
+//!   its neighbours along the edge; the edge is reproduced only if the vertices of the flat cells
+//!   beside it are definitely inside. A linear cell (QEF rank one) that straddles the surface would
+//!   put its vertex at its centre, on whichever side the centre happens to be, and a whole edge of a
+//!   box in general position came out chamfered. Such vertices are moved a quarter cell into the
+//!   solid along the gradient (clamped to the leaf), which reproduces convex and concave edges alike.
+//! - **Sliver elimination (§4).** Where a linear cell straddles the surface and the QEF restricted
+//!   to `w = 0` has a residual within the tolerance (and the field there is within the tolerance of
+//!   zero), the restricted minimiser, a point on the surface, becomes the vertex, *counted as
+//!   inside*: its crossings then all land next to it, [`super::slivers`] merges them into it, and
+//!   the sign pattern is that of the quarter-cell rule above. Measured on a ball this halves the
+//!   triangles and lifts the smallest angle from about 3° to above 20°. Next to a feature
+//!   ([`near_features`]) the restricted vertex is not used: surface vertices crowding a crease or a
+//!   thin wall folded the contour there.
 //! - A pruned leaf's vertex is its centre (flattened onto the boundary for boundary cells); it never
-//!   reaches the output (see `refine.rs`).
+//!   reaches the output (see `refine.rs`). So is a *centred* leaf's, the fallback of refinement
+//!   rules 4 and 5.
 
 use super::dual::CellRef;
 use super::octree::{Kind, Octree, NONE};

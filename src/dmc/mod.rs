@@ -193,43 +193,29 @@ pub fn mesh_field(
             continue;
         }
         let revert = features::near_features(&tree, &refs);
+
+        let t = Instant::now();
+        let contour = contour::contour(&ids, &vertices, field, options.iso);
+        stats.contour_ms += ms_since(t);
+
+        let t = Instant::now();
+        let plan = refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour);
         for &n in &revert {
             let node = &mut tree.nodes[n as usize];
             node.keep_free = true;
             node.has_vertex = false;
         }
-        if !revert.is_empty() {
-            continue;
-        }
-
-        let t = Instant::now();
-        let mut contour = contour::contour(&ids, &vertices, field, options.iso);
-        stats.contour_ms += ms_since(t);
-
-        let centre = refine::to_centre(&tree, field, &refs, &contour);
-        if centre_leaves(&mut tree, &centre) {
-            continue;
-        }
-
-        let t = Instant::now();
-        let split = refine::to_refine(&tree, field, &refs, &ids, &vertices.values, &contour);
-        for &n in &split {
-            tree.refine(field, n)?;
-        }
+        let changed = apply(&mut tree, field, &plan)? || !revert.is_empty();
         stats.octree_ms += ms_since(t);
-        if !split.is_empty() {
+        if changed {
             continue;
         }
 
         let t = Instant::now();
-        if options.sliver_elimination {
-            stats.slivers_removed =
-                slivers::collapse(&mut contour, &vertices, field, options.iso, params.tolerance);
-        }
-        let pairs = crate::mesh::analysis::self_intersecting_pairs(&contour.mesh);
+        let (contour, pairs) = finish(contour, &vertices, field, options, params.tolerance, &mut stats);
         stats.contour_ms += ms_since(t);
-        let tangled = refine::tangled(&tree, &refs, &contour, &pairs);
-        if !centre_leaves(&mut tree, &tangled) {
+        let plan = refine::untangle(&tree, &refs, &contour, &pairs);
+        if !apply(&mut tree, field, &plan)? {
             break contour;
         }
     };
@@ -243,13 +229,55 @@ pub fn mesh_field(
     Ok((mesh, stats))
 }
 
-/// Puts the vertices of `leaves` at their cells' centres (rules 4 and 5 of `refine`); whether any
-/// changed.
-fn centre_leaves(tree: &mut Octree, leaves: &[u32]) -> bool {
-    for &n in leaves {
+/// Applies a refinement plan; whether it changed anything.
+fn apply(tree: &mut Octree, field: &dyn Field, plan: &refine::Plan) -> Result<bool, Error> {
+    for &n in &plan.split {
+        tree.refine(field, n)?;
+    }
+    for &n in &plan.centre {
         let node = &mut tree.nodes[n as usize];
         node.centred = true;
         node.has_vertex = false;
     }
-    !leaves.is_empty()
+    Ok(!plan.is_empty())
+}
+
+/// Sliver collapse and the final self-intersection check. A merge that makes two sheets cross (thin
+/// walls bring sheets within the tolerance of each other) is undone by collapsing again without the
+/// dual vertices involved; intersections that remain are the dual grid's (rule 5).
+fn finish(
+    contour: contour::Contour,
+    vertices: &DualVertices,
+    field: &dyn Field,
+    options: &DmcOptions,
+    tolerance: f32,
+    stats: &mut DmcStats,
+) -> (contour::Contour, Vec<[u32; 2]>) {
+    let intersections = |c: &contour::Contour| crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
+    if !options.sliver_elimination {
+        let pairs = intersections(&contour);
+        return (contour, pairs);
+    }
+    let mut skip = std::collections::BTreeSet::new();
+    for _ in 0..3 {
+        let mut collapsed = contour.clone();
+        let (removed, merged) =
+            slivers::collapse(&mut collapsed, vertices, field, options.iso, tolerance, &skip);
+        let pairs = intersections(&collapsed);
+        let culprits: Vec<u32> = pairs
+            .iter()
+            .flatten()
+            .flat_map(|&t| collapsed.mesh.triangles[t as usize])
+            .map(|v| merged[v as usize])
+            .filter(|&d| d != u32::MAX)
+            .collect();
+        if pairs.is_empty() || culprits.is_empty() {
+            stats.slivers_removed = removed;
+            return (collapsed, pairs);
+        }
+        skip.extend(culprits);
+    }
+    let pairs = intersections(&contour);
+    stats.slivers_removed = 0;
+    (contour, pairs)
 }

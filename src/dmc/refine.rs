@@ -29,7 +29,8 @@
 use super::contour::{triangle_error, Contour};
 use super::dual::CellRef;
 use super::octree::{Kind, Octree};
-use crate::field::Field;
+use crate::field::{finite_difference_gradient, Field};
+use glam::Vec3;
 
 fn is_mixed(cell: &[u32; 8], values: &[f32]) -> bool {
     let first = values[cell[0] as usize] < 0.0;
@@ -50,18 +51,70 @@ pub fn to_unprune(tree: &Octree, refs: &[[CellRef; 8]], ids: &[[u32; 8]], values
     out
 }
 
-/// Rules 2 and 3: sampled leaves above the maximum depth that must be split.
-pub fn to_refine(
+/// What to do to the octree after a contour: leaves to split, leaves whose vertex goes to the centre.
+#[derive(Debug, Default)]
+pub struct Plan {
+    pub split: Vec<u32>,
+    pub centre: Vec<u32>,
+}
+
+impl Plan {
+    pub fn is_empty(&self) -> bool {
+        self.split.is_empty() && self.centre.is_empty()
+    }
+
+    fn finish(mut self) -> Plan {
+        for v in [&mut self.split, &mut self.centre] {
+            v.sort_unstable();
+            v.dedup();
+        }
+        // A leaf being split needs no centring.
+        let split = &self.split;
+        self.centre.retain(|n| split.binary_search(n).is_err());
+        self
+    }
+
+    /// Split the largest splittable sampled leaves of a dual cell; where none can be split,
+    /// centre its sampled leaves instead (when `centre_if_stuck`).
+    fn treat(&mut self, tree: &Octree, cell: &[CellRef; 8], centre_if_stuck: bool) {
+        let largest =
+            cell.iter().filter(|r| splittable(tree, r.node)).map(|r| tree.nodes[r.node as usize].depth).min();
+        match largest {
+            Some(depth) => self.split.extend(
+                cell.iter()
+                    .map(|r| r.node)
+                    .filter(|&n| splittable(tree, n) && tree.nodes[n as usize].depth == depth),
+            ),
+            None if centre_if_stuck => {
+                self.centre.extend(cell.iter().map(|r| r.node).filter(|&n| {
+                    tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred
+                }))
+            }
+            None => {}
+        }
+    }
+}
+
+fn splittable(tree: &Octree, n: u32) -> bool {
+    tree.nodes[n as usize].kind == Kind::Leaf && tree.nodes[n as usize].depth < tree.params.max_depth
+}
+
+/// Rules 2, 3 and 4 on a contour of the mixed dual cells `refs` (vertex ids `ids`).
+///
+/// Rule 4: a triangle facing away from the field's gradient at all three of its vertices (which lie
+/// on the surface, so their gradient is the surface normal of their own sheet) is folded over.
+/// Vertices far from their cells' centres can fold a dual cell. Its largest leaves are split; at
+/// the maximum depth its leaves fall back to their centres instead, where the dual grid is that of
+/// the paper's §5 variant and cannot fold, at the price of sharpness there.
+pub fn plan(
     tree: &Octree,
     field: &dyn Field,
     refs: &[[CellRef; 8]],
     ids: &[[u32; 8]],
     values: &[f32],
     contour: &Contour,
-) -> Vec<u32> {
-    let splittable = |n: u32| {
-        tree.nodes[n as usize].kind == Kind::Leaf && tree.nodes[n as usize].depth < tree.params.max_depth
-    };
+) -> Plan {
+    let mut plan = Plan::default();
     let mut represented = vec![false; tree.nodes.len()];
     for (r, cell) in refs.iter().zip(ids) {
         if is_mixed(cell, values) {
@@ -70,69 +123,50 @@ pub fn to_refine(
             }
         }
     }
-    let mut out: Vec<u32> = tree
-        .leaves()
-        .filter(|&n| splittable(n) && tree.nodes[n as usize].straddles && !represented[n as usize])
-        .collect();
+    plan.split
+        .extend(tree.leaves().filter(|&n| {
+            splittable(tree, n) && tree.nodes[n as usize].straddles && !represented[n as usize]
+        }));
     let tolerance = tree.params.tolerance;
     let h = tree.cell_size(tree.params.max_depth) * 1e-2;
-    let mut bad_cells: Vec<u32> = (0..contour.mesh.triangle_count())
-        .filter(|&t| triangle_error(&contour.mesh, t, field, tree.params.iso, h) > tolerance)
-        .map(|t| contour.cell_of_triangle[t])
+    let mesh = &contour.mesh;
+    let gradients: Vec<Vec3> = mesh
+        .positions
+        .iter()
+        .map(|&p| field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)))
         .collect();
-    bad_cells.sort_unstable();
-    bad_cells.dedup();
-    for c in bad_cells {
-        let cell = &refs[c as usize];
-        let largest =
-            cell.iter().filter(|r| splittable(r.node)).map(|r| tree.nodes[r.node as usize].depth).min();
-        if let Some(depth) = largest {
-            out.extend(
-                cell.iter()
-                    .map(|r| r.node)
-                    .filter(|&n| splittable(n) && tree.nodes[n as usize].depth == depth),
-            );
+    let mut inaccurate = Vec::new();
+    let mut folded = Vec::new();
+    for t in 0..mesh.triangle_count() {
+        let [a, b, c] = mesh.corners(t);
+        let normal = (b - a).cross(c - a);
+        if mesh.triangles[t].iter().all(|&v| normal.dot(gradients[v as usize]) < 0.0) {
+            folded.push(contour.cell_of_triangle[t]);
+        } else if triangle_error(mesh, t, field, tree.params.iso, h) > tolerance {
+            inaccurate.push(contour.cell_of_triangle[t]);
         }
     }
-    out.sort_unstable();
-    out.dedup();
-    out
+    for (cells, centre_if_stuck) in [(inaccurate, false), (folded, true)] {
+        let mut cells = cells;
+        cells.sort_unstable();
+        cells.dedup();
+        for c in cells {
+            plan.treat(tree, &refs[c as usize], centre_if_stuck);
+        }
+    }
+    plan.finish()
 }
 
-/// Rule 4: sampled leaves of dual cells whose contour folds over (a triangle facing away from the
-/// field's gradient by more than 90°). Vertices far from their cells' centres can fold a dual cell;
-/// these leaves fall back to their centres, where the dual grid is regular and Marching Cubes
-/// cannot fold (the paper's §5 variant), at the price of sharpness there.
-pub fn to_centre(tree: &Octree, field: &dyn Field, refs: &[[CellRef; 8]], contour: &Contour) -> Vec<u32> {
-    let h = tree.cell_size(tree.params.max_depth) * 1e-2;
-    let mut out: Vec<u32> = (0..contour.mesh.triangle_count())
-        .filter(|&t| {
-            let [a, b, c] = contour.mesh.corners(t);
-            let normal = (b - a).cross(c - a);
-            let p = (a + b + c) / 3.0;
-            let g =
-                field.gradient(p).unwrap_or_else(|| crate::field::finite_difference_gradient(field, p, h));
-            normal.dot(g) < 0.0
-        })
-        .flat_map(|t| refs[contour.cell_of_triangle[t] as usize].iter().map(|r| r.node))
-        .filter(|&n| tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred)
-        .collect();
-    out.sort_unstable();
-    out.dedup();
-    out
-}
-
-/// Rule 5: sampled, not yet centred leaves of the dual cells that made intersecting triangles (the
-/// final check, after sliver collapse). Folds that rule 4 misses — two sheets of the contour
-/// crossing where several features meet in one cell — are undone the same way.
-pub fn tangled(tree: &Octree, refs: &[[CellRef; 8]], contour: &Contour, pairs: &[[u32; 2]]) -> Vec<u32> {
-    let mut out: Vec<u32> = pairs
-        .iter()
-        .flatten()
-        .flat_map(|&t| refs[contour.cell_of_triangle[t as usize] as usize].iter().map(|r| r.node))
-        .filter(|&n| tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred)
-        .collect();
-    out.sort_unstable();
-    out.dedup();
-    out
+/// Rule 5: the dual cells that made intersecting triangles (the final check, after sliver
+/// collapse) are treated like folded ones. It catches what rule 4 misses: two sheets of the
+/// contour crossing where several features meet in one cell.
+pub fn untangle(tree: &Octree, refs: &[[CellRef; 8]], contour: &Contour, pairs: &[[u32; 2]]) -> Plan {
+    let mut plan = Plan::default();
+    let mut cells: Vec<u32> = pairs.iter().flatten().map(|&t| contour.cell_of_triangle[t as usize]).collect();
+    cells.sort_unstable();
+    cells.dedup();
+    for c in cells {
+        plan.treat(tree, &refs[c as usize], true);
+    }
+    plan.finish()
 }

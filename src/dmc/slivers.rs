@@ -15,16 +15,19 @@ use super::contour::Contour;
 use super::features::DualVertices;
 use crate::field::Field;
 use glam::{DVec3, Vec3};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
-/// Merges crossings clustered around dual vertices; returns the number of triangles removed.
+/// Merges crossings clustered around dual vertices, except around those in `skip`. Returns the
+/// number of triangles removed and, per vertex of the result, the dual vertex it was merged into
+/// (`u32::MAX` for vertices left alone).
 pub fn collapse(
     contour: &mut Contour,
     vertices: &DualVertices,
     field: &dyn Field,
     iso: f32,
     tolerance: f32,
-) -> usize {
+    skip: &BTreeSet<u32>,
+) -> (usize, Vec<u32>) {
     let mesh = &mut contour.mesh;
     let mut groups: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     for (v, c) in contour.crossings.iter().enumerate() {
@@ -43,8 +46,9 @@ pub fn collapse(
     }
     let mut alive = vec![true; mesh.triangles.len()];
     let mut removed = 0;
+    let mut merged_into = vec![u32::MAX; mesh.positions.len()];
     for (dual, members) in groups {
-        if members.len() < 2 {
+        if members.len() < 2 || skip.contains(&dual) {
             continue;
         }
         let target = project(field, iso, vertices.positions[dual as usize], tolerance);
@@ -93,6 +97,7 @@ pub fn collapse(
             mesh.triangles[t as usize] = new;
         }
         mesh.positions[merged as usize] = target;
+        merged_into[merged as usize] = dual;
         let all: Vec<u32> = kept.iter().map(|&(t, _)| t).collect();
         for &m in &members {
             incident[m as usize].clear();
@@ -109,13 +114,14 @@ pub fn collapse(
         }
     }
     let mut new_id = vec![u32::MAX; mesh.positions.len()];
-    let (mut positions, mut crossings) = (Vec::new(), Vec::new());
+    let (mut positions, mut crossings, mut merged) = (Vec::new(), Vec::new(), Vec::new());
     for tri in &mut triangles {
         for v in tri.iter_mut() {
             if new_id[*v as usize] == u32::MAX {
                 new_id[*v as usize] = positions.len() as u32;
                 positions.push(mesh.positions[*v as usize]);
                 crossings.push(contour.crossings[*v as usize]);
+                merged.push(merged_into[*v as usize]);
             }
             *v = new_id[*v as usize];
         }
@@ -124,7 +130,7 @@ pub fn collapse(
     mesh.positions = positions;
     contour.crossings = crossings;
     contour.cell_of_triangle = cells;
-    removed
+    (removed, merged)
 }
 
 /// Whether the triangles around `center` (each containing it once) form one closed fan: their
