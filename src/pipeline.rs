@@ -3,10 +3,12 @@
 
 use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
+use crate::expr::{self, Program};
 use crate::field::{Field, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mesh::Mesh;
+use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
 
@@ -90,6 +92,7 @@ impl Request {
             phi_corner: self.phi_corner,
             directed: self.directed,
             flip_edges: true,
+            crust: true,
             topology: self.topology,
             max_cells: self.max_cells,
         }
@@ -112,16 +115,19 @@ struct Meshed {
     phases: Vec<(String, f64)>,
     /// Edge features, corner features, flips (EMC).
     feature_counts: [usize; 3],
+    /// Points evaluated and grid points (EMC).
+    evaluations: Option<(usize, usize)>,
 }
 
 impl Meshed {
     fn plain(mesh: Mesh, phases: Vec<(String, f64)>) -> Meshed {
-        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3] }
+        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3], evaluations: None }
     }
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
         Meshed {
             feature_counts: [out.edge_features, out.corner_features, out.flips],
+            evaluations: Some((out.points_evaluated, out.grid_points)),
             phases: timings.phases(),
             mesh: out.mesh,
             feature_edges: out.feature_edges,
@@ -131,6 +137,8 @@ impl Meshed {
     fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
         let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
+        stats.points_evaluated = self.evaluations.map(|e| e.0);
+        stats.grid_points = self.evaluations.map(|e| e.1);
         Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
     }
 }
@@ -152,6 +160,31 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
     };
     let shifted = Shifted { field, iso: request.iso };
     Ok(meshed.analyse(request.method, request.res, &shifted, request.analysis))
+}
+
+/// Where programs (typed or CSG) are meshed unless the request names bounds: [-1, 1]³.
+pub const DEFAULT_BOUNDS: (Vec3, Vec3) = (Vec3::splat(-1.0), Vec3::splat(1.0));
+
+/// Meshes a built-in scene (see [`scenes::SCENE_NAMES`]) in its own bounds.
+pub fn mesh_scene(name: &str, request: &Request) -> Result<Output, Error> {
+    let scene = scenes::scene(name)?;
+    mesh_field(scene.field.as_ref(), (scene.min, scene.max), request)
+}
+
+/// Meshes a compiled program over the request's bounds, or [`DEFAULT_BOUNDS`].
+pub fn mesh_program(program: &Program, request: &Request) -> Result<Output, Error> {
+    mesh_field(program, DEFAULT_BOUNDS, request)
+}
+
+/// Compiles a program in the expression language and meshes it like [`mesh_program`]. A
+/// malformed program fails with [`Error::Parse`] (line, column and a caret under the spot).
+pub fn mesh_expr(text: &str, request: &Request) -> Result<Output, Error> {
+    mesh_program(&expr::compile(text)?, request)
+}
+
+/// Compiles a CSG tree in JSON (see [`crate::expr::csg`]) and meshes it like [`mesh_program`].
+pub fn mesh_csg_json(json: &str, request: &Request) -> Result<Output, Error> {
+    mesh_program(&Program::from_csg_json(json)?, request)
 }
 
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
@@ -185,5 +218,51 @@ impl Field for Shifted<'_> {
     }
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         self.field.gradient(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quick() -> Request {
+        Request {
+            res: 16,
+            analysis: AnalysisOptions { self_intersections: false, surface_error: true },
+            ..Request::default()
+        }
+    }
+
+    #[test]
+    fn text_csg_and_scene_paths_mesh_the_same_sphere() {
+        let from_text = mesh_expr("sphere(0.8)", &quick()).unwrap();
+        let from_csg = mesh_csg_json(r#"{"op": "sphere", "radius": 0.8}"#, &quick()).unwrap();
+        let from_scene = mesh_scene("sphere", &quick()).unwrap();
+        assert_eq!(
+            from_text.mesh.positions, from_scene.mesh.positions,
+            "default bounds are the scene's [-1, 1]³"
+        );
+        assert_eq!(from_csg.mesh.triangles, from_scene.mesh.triangles);
+        assert_eq!(from_text.stats.euler, 2);
+        assert!(from_text.stats.dist_max.unwrap() < 0.01);
+    }
+
+    #[test]
+    fn requested_bounds_replace_the_default_ones() {
+        let request = Request { bounds: Some((Vec3::splat(-3.0), Vec3::splat(3.0))), ..quick() };
+        let out = mesh_expr("sphere(2.5)", &request).unwrap();
+        assert!(out.stats.closed_manifold && out.stats.euler == 2);
+        let clipped = mesh_expr("sphere(2.5)", &quick()).unwrap();
+        assert_eq!(
+            clipped.stats.triangles, 0,
+            "a sphere containing the default bounds has no surface in them"
+        );
+    }
+
+    #[test]
+    fn parse_errors_come_back_with_their_position() {
+        let err = mesh_expr("union(sphere(1),\n  box(1, 2)", &quick()).unwrap_err();
+        assert!(matches!(err, Error::Parse { line: 2, .. }), "{err}");
+        assert!(err.to_string().contains('^'));
     }
 }

@@ -66,6 +66,9 @@ pub struct Stats {
     pub corner_features: usize,
     /// Edges flipped to make feature lines explicit (EMC).
     pub flips: usize,
+    /// Grid points where the field was evaluated (EMC's crust skips the rest), and the grid's size.
+    pub points_evaluated: Option<usize>,
+    pub grid_points: Option<usize>,
 }
 
 impl Stats {

@@ -147,3 +147,34 @@ fn options_out_of_range_are_refused() {
     let err = emc::mesh_field(&field, &grid, &bad).unwrap_err();
     assert!(err.to_string().contains("thetaSharp"), "{err}");
 }
+
+#[test]
+fn the_crust_traversal_gives_the_uniform_grid_result_from_far_fewer_evaluations() {
+    for text in [CUBE_MINUS_SPHERE, ROTATED_BOX, "length(length(x, y) - .6, z) - .25"] {
+        let field = expr::compile(text).unwrap();
+        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), 64).unwrap();
+        let (crust, _) = emc::mesh_field(&field, &grid, &EmcOptions::default()).unwrap();
+        let uniform_options = EmcOptions { crust: false, ..EmcOptions::default() };
+        let (uniform, _) = emc::mesh_field(&field, &grid, &uniform_options).unwrap();
+        assert_eq!(crust.mesh, uniform.mesh, "{text}");
+        assert_eq!(uniform.points_evaluated, grid.point_count());
+        assert!(crust.points_evaluated * 3 < grid.point_count(), "{text}: {}", crust.points_evaluated);
+    }
+}
+
+#[test]
+fn every_scene_keeps_mc_topology_without_self_intersections() {
+    for name in isoforge::scenes::SCENE_NAMES {
+        let scene = isoforge::scenes::scene(name).unwrap();
+        for res in [24, 40] {
+            let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+            let (mc_mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+            let (emc, _) = emc::mesh_field(scene.field.as_ref(), &grid, &EmcOptions::default()).unwrap();
+            let what = format!("{name} at {res}");
+            let mc_topo = analysis::topology(&mc_mesh);
+            let emc_topo = assert_watertight(&emc.mesh, &what);
+            assert_eq!(emc_topo.euler, mc_topo.euler, "{what}");
+            assert_eq!(emc_topo.components, mc_topo.components, "{what}");
+        }
+    }
+}

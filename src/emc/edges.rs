@@ -8,6 +8,44 @@ use crate::field::{finite_difference_gradient, Field};
 use crate::mc::MIN_EDGE_FRACTION;
 use glam::Vec3;
 
+/// A source of EMC's edge samples: where the surface crosses a grid edge, and its normal there.
+pub trait EdgeSampler {
+    /// The crossing on the segment `a → b`, whose end values (minus the iso-level) `da`, `db` have
+    /// opposite signs, as the fraction `t` of the way from `a`, and the unit outward normal there.
+    fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3);
+}
+
+/// Crossings of a field: exact by root finding (`directed`), or interpolated from the end values;
+/// normals from the field's gradient.
+pub struct FieldRoots<'a> {
+    pub field: &'a dyn Field,
+    pub iso: f32,
+    pub directed: bool,
+    /// Step for finite-difference gradients when the field has none.
+    pub h: f32,
+}
+
+impl EdgeSampler for FieldRoots<'_> {
+    fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3) {
+        let t = if self.directed { edge_root(self.field, self.iso, a, b, da, db) } else { da / (da - db) };
+        (t, field_normal(self.field, a + (b - a) * t, self.h * 1e-3))
+    }
+}
+
+/// Crossings of a sampled volume without a function behind it: linear interpolation (the
+/// baseline the paper improves on), normals from the samples' central differences.
+pub struct SampleInterpolation<'a> {
+    pub values: &'a [f32],
+    pub grid: &'a crate::grid::Grid,
+}
+
+impl EdgeSampler for SampleInterpolation<'_> {
+    fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3) {
+        let t = da / (da - db);
+        (t, crate::mc::sample_gradient(self.values, self.grid, a + (b - a) * t).normalize_or_zero())
+    }
+}
+
 /// Root of `f - iso` on the segment `a..b`, given the signed values `da = f(a) - iso < 0 <= db` (or
 /// the reverse), as a fraction `t` of the way from `a` to `b`.
 ///

@@ -12,8 +12,13 @@ use std::collections::HashMap;
 pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool]) -> usize {
     // Directed edge (from, to) → the triangle that has it. Closed manifold meshes have each edge
     // once in each direction.
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.triangles.len() * 3);
+    // Only triangles at a feature point can take part in a flip (both triangles of a flipped edge
+    // have one), which keeps this map small: feature cells are few.
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
     for (t, tri) in mesh.triangles.iter().enumerate() {
+        if !tri.iter().any(|&v| is_feature[v as usize]) {
+            continue;
+        }
         for k in 0..3 {
             directed.insert((tri[k], tri[(k + 1) % 3]), t as u32);
         }

@@ -6,6 +6,7 @@
 //! The topology is exactly plain MC's on the same grid (same polygons from [`crate::tables`]), so
 //! EMC inherits its watertightness; only the geometry inside each cell changes.
 
+pub mod crust;
 pub mod edges;
 pub mod feature;
 pub mod flip;
@@ -14,14 +15,15 @@ use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{joined_faces, ms_since, polygon_center, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
 use crate::tables::{
     polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
     CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS,
 };
-use edges::{edge_root, field_normal};
+use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, feature_point, FeatureKind};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use web_time::Instant;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +39,9 @@ pub struct EmcOptions {
     pub flip_edges: bool,
     pub topology: Topology,
     pub max_cells: u64,
+    /// Evaluate the field only where its interval bounds say the surface may be (§2's crust);
+    /// the output is identical. Fields without interval bounds are sampled everywhere.
+    pub crust: bool,
 }
 
 impl Default for EmcOptions {
@@ -49,6 +54,7 @@ impl Default for EmcOptions {
             flip_edges: true,
             topology: Topology::Fixed,
             max_cells: DEFAULT_MAX_CELLS,
+            crust: true,
         }
     }
 }
@@ -82,6 +88,9 @@ pub struct EmcMesh {
     pub edge_features: usize,
     pub corner_features: usize,
     pub flips: usize,
+    /// Grid points where the field was evaluated, and how many the grid has.
+    pub points_evaluated: usize,
+    pub grid_points: usize,
     /// Sharp components whose fan around the feature point would fold over (the planes meet
     /// outside the cell) and were meshed as plain MC instead.
     pub rejected_features: usize,
@@ -113,9 +122,15 @@ pub fn mesh_field(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let values = sample_grid(field, grid)?;
+    let crust = if options.crust { crust::sample_crust(field, grid, options.iso).transpose()? } else { None };
+    let (values, evaluated) = match crust {
+        Some(c) => (c.values, c.evaluated),
+        None => (sample_grid(field, grid)?, grid.point_count()),
+    };
     let sample_ms = ms_since(t0);
-    let (mesh, mut timings) = run(&values, grid, options, Some(field))?;
+    let sampler = FieldRoots { field, iso: options.iso, directed: options.directed, h: grid.cell_size() };
+    let (mut mesh, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;
+    mesh.points_evaluated = evaluated;
     timings.sample_ms = sample_ms;
     Ok((mesh, timings))
 }
@@ -129,18 +144,28 @@ pub fn mesh_samples(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     check_finite(values, grid)?;
-    run(values, grid, options, None)
+    let (mut mesh, timings) =
+        mesh_with_sampler(values, grid, options, &SampleInterpolation { values, grid })?;
+    mesh.points_evaluated = grid.point_count();
+    Ok((mesh, timings))
 }
 
-fn run(
+/// EMC from grid values (their signs pick the MC case, `value - iso < 0` inside) and any source of
+/// edge crossings: the entry point for inputs that are neither fields nor plain samples, such as
+/// triangle meshes (ray casting) and point clouds (tangent planes).
+pub fn mesh_with_sampler(
     values: &[f32],
     grid: &Grid,
     options: &EmcOptions,
-    field: Option<&dyn Field>,
+    sampler: &dyn EdgeSampler,
 ) -> Result<(EmcMesh, EmcTimings), Error> {
+    options.validate()?;
+    grid.check_size(options.max_cells)?;
+    check_finite(values, grid)?;
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
-    let mut out = extract(values, grid, options, field);
+    let mut out = extract(values, grid, options, sampler);
+    out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
     if options.flip_edges {
@@ -151,35 +176,24 @@ fn run(
     Ok((out, timings))
 }
 
-/// Edge crossing: position and unit normal.
+/// Where the surface crosses cell edge `e` and its unit normal there, from `sampler`.
 fn crossing(
-    values: &[f32],
     grid: &Grid,
-    options: &EmcOptions,
-    field: Option<&dyn Field>,
+    sampler: &dyn EdgeSampler,
     cell: [usize; 3],
     e: usize,
     d: &[f32; 8],
 ) -> (Vec3, Vec3) {
     let [a, b] = EDGES[e];
-    let (da, db) = (d[a as usize], d[b as usize]);
     let ca = CORNERS[a as usize];
     let pa = grid.position(cell[0] + ca[0], cell[1] + ca[1], cell[2] + ca[2]);
     let mut step = Vec3::ZERO;
     step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
-    let t = match field {
-        Some(f) if options.directed => edge_root(f, options.iso, pa, pa + step, da, db),
-        _ => (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION),
-    };
-    let p = pa + step * t;
-    let n = match field {
-        Some(f) => field_normal(f, p, grid.cell_size() * 1e-3),
-        None => crate::mc::sample_gradient(values, grid, p).normalize_or_zero(),
-    };
-    (p, n)
+    let (t, n) = sampler.crossing(pa, pa + step, d[a as usize], d[b as usize]);
+    (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
 }
 
-fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn Field>) -> EmcMesh {
+fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn EdgeSampler) -> EmcMesh {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -214,15 +228,17 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                 let mut first_triangle = 0;
                 let cell_min = grid.position(i, j, k);
                 let cell_max = cell_min + grid.spacing;
+                // Pass 1: the polygons' vertices, and for each a feature point where it is sharp.
+                let mut plans: Vec<Plan> = Vec::with_capacity(4);
                 for (p, poly) in polygons.iter().enumerate() {
                     let count = triangles.per_polygon[p] as usize;
-                    let group = &triangles.edges[3 * first_triangle..3 * (first_triangle + count)];
+                    let group = first_triangle..first_triangle + count;
                     first_triangle += count;
                     let mut by_edge = [NONE; 13];
                     for &e in poly {
                         let slot = cache.slot(i, j, e as usize);
                         if *slot == NONE {
-                            let (p, n) = crossing(values, grid, options, field, [i, j, k], e as usize, &d);
+                            let (p, n) = crossing(grid, sampler, [i, j, k], e as usize, &d);
                             *slot = out.mesh.positions.len() as u32;
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
@@ -233,29 +249,52 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                     let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
-                    let mut f = Vec3::ZERO;
+                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        // One bad solve must not throw a spike: the point stays inside its cell, or
-                        // (where the planes meet just outside it and clamping would fold the fan)
-                        // within half a cell of it.
+                        // One bad solve must not throw a spike: the point stays inside its cell
+                        // (strictly, so no fan triangle lies in a cell face), or, where the planes
+                        // meet just outside it and clamping would fold the fan, within half a cell.
                         let solved = feature_point(&pts, &nrm, kind);
-                        f = solved.clamp(cell_min, cell_max);
+                        let inset = grid.spacing * 1e-2;
+                        let mut f = solved.clamp(cell_min + inset, cell_max - inset);
                         if !fan_is_valid(f, &pts, &nrm) {
                             let margin = grid.spacing * 0.5;
                             f = solved.clamp(cell_min - margin, cell_max + margin);
                         }
                         // Where neither works, the component stays plain MC.
-                        if !fan_is_valid(f, &pts, &nrm) {
-                            kind = FeatureKind::Smooth;
+                        if fan_is_valid(f, &pts, &nrm) {
+                            feature = Some((f, kind));
+                        } else {
                             out.rejected_features += 1;
                         }
                     }
-                    if kind == FeatureKind::Smooth {
+                    plans.push(Plan { by_edge, ids, pts, nrm, group, feature });
+                }
+                // Pass 2: where a cell holds several components (sheets close together), a fan
+                // that would cut another component's triangles falls back to MC.
+                for a in 0..plans.len() {
+                    if plans.len() > 1 && plans[a].feature.is_some() {
+                        let fan = plans[a].triangles(&out.mesh.positions, triangles);
+                        let cuts = (0..plans.len()).filter(|&b| b != a).any(|b| {
+                            let other = plans[b].triangles(&out.mesh.positions, triangles);
+                            fan.iter().any(|t| other.iter().any(|u| triangles_intersect(t, u)))
+                        });
+                        if cuts {
+                            plans[a].feature = None;
+                            out.rejected_features += 1;
+                        }
+                    }
+                }
+                // Pass 3: emit.
+                for plan in plans {
+                    let Some((f, kind)) = plan.feature else {
+                        let mut by_edge = plan.by_edge;
+                        let group = &triangles.edges[3 * plan.group.start..3 * plan.group.end];
                         if group.contains(&CENTER) {
                             by_edge[CENTER as usize] = out.mesh.positions.len() as u32;
                             out.mesh.positions.push(polygon_center(&out.mesh.positions, group, &by_edge));
-                            normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                            normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
                         }
                         for t in group.chunks_exact(3) {
@@ -266,15 +305,16 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
                             ]);
                         }
                         continue;
-                    }
+                    };
                     let fid = out.mesh.positions.len() as u32;
                     out.mesh.positions.push(f);
-                    normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                    normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                     out.feature_vertex.push(true);
                     match kind {
                         FeatureKind::Corner => out.corner_features += 1,
                         _ => out.edge_features += 1,
                     }
+                    let ids = &plan.ids;
                     for q in 0..ids.len() {
                         out.mesh.triangles.push([fid, ids[q], ids[(q + 1) % ids.len()]]);
                     }
@@ -284,6 +324,46 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, field: Option<&dyn
     }
     out.mesh.normals = normals_of_vertex;
     out
+}
+
+/// What one component of a cell will become: its polygon and, where sharp, its feature point.
+struct Plan {
+    by_edge: [u32; 13],
+    /// The polygon's vertex ids and positions, in order.
+    ids: Vec<u32>,
+    pts: Vec<Vec3>,
+    nrm: Vec<Vec3>,
+    /// Its triangles in the cell's MC triangulation (triangle indices).
+    group: std::ops::Range<usize>,
+    feature: Option<(Vec3, FeatureKind)>,
+}
+
+impl Plan {
+    /// The triangles this component would emit, as positions (fan or MC triangulation).
+    fn triangles(&self, positions: &[Vec3], table: &CellTriangles) -> Vec<[DVec3; 3]> {
+        let n = self.pts.len();
+        match self.feature {
+            Some((f, _)) => {
+                (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
+            }
+            None => {
+                let group = &table.edges[3 * self.group.start..3 * self.group.end];
+                let center = self.pts.iter().sum::<Vec3>() / n as f32;
+                group
+                    .chunks_exact(3)
+                    .map(|t| {
+                        [t[0], t[1], t[2]].map(|e| {
+                            if e == CENTER {
+                                center.as_dvec3()
+                            } else {
+                                positions[self.by_edge[e as usize] as usize].as_dvec3()
+                            }
+                        })
+                    })
+                    .collect()
+            }
+        }
+    }
 }
 
 /// A fan around `center` is valid when every triangle faces the way the field's normals at its

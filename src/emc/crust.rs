@@ -1,0 +1,172 @@
+//! The adaptive "crust" traversal of EMC §2: refine only the parts of the grid that can contain the
+//! surface, and evaluate the field only at the corners of the finest cells that do.
+//!
+//! The result is sample-for-sample what the uniform grid would give wherever the surface is: a box
+//! whose interval bounds exclude the iso-level has every value of one sign, so its points get a
+//! stand-in value of that sign (the bound nearest the iso-level), and a cell of such a box has no
+//! sign change on either grid. Cells that may hold the surface are evaluated exactly.
+
+use crate::error::Error;
+use crate::field::Field;
+use crate::grid::Grid;
+
+/// Boxes at most this many cells on a side are sampled without further bounding.
+const LEAF_CELLS: usize = 4;
+
+/// Samples for a whole grid, of which only the crust was evaluated.
+pub struct CrustSamples {
+    pub values: Vec<f32>,
+    /// Points where the field was actually evaluated.
+    pub evaluated: usize,
+    /// Interval evaluations made by the traversal.
+    pub interval_queries: usize,
+}
+
+/// Samples `field` on `grid` through the crust traversal, or `None` when the field gives no
+/// interval bounds (then the caller samples every point).
+pub fn sample_crust(field: &dyn Field, grid: &Grid, iso: f32) -> Option<Result<CrustSamples, Error>> {
+    field.interval(grid.origin, grid.origin + grid.spacing)?;
+    let mut state = Traversal {
+        field,
+        grid,
+        iso,
+        values: vec![f32::NAN; grid.point_count()],
+        marked: vec![false; grid.point_count()],
+        interval_queries: 0,
+    };
+    state.visit([0, 0, 0], grid.cells);
+    Some(state.finish())
+}
+
+struct Traversal<'a> {
+    field: &'a dyn Field,
+    grid: &'a Grid,
+    iso: f32,
+    values: Vec<f32>,
+    /// Points that are corners of a cell that may hold the surface.
+    marked: Vec<bool>,
+    interval_queries: usize,
+}
+
+impl Traversal<'_> {
+    /// Visits the cells `lo .. hi` (cell indices, half-open).
+    fn visit(&mut self, lo: [usize; 3], hi: [usize; 3]) {
+        let (wlo, whi) = (self.grid.position(lo[0], lo[1], lo[2]), self.grid.position(hi[0], hi[1], hi[2]));
+        self.interval_queries += 1;
+        let (vlo, vhi) = self.field.interval(wlo, whi).unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
+        let (vlo, vhi) = (vlo - self.iso, vhi - self.iso);
+        if vlo > 0.0 || vhi < 0.0 {
+            let stand_in = if vlo > 0.0 { vlo } else { vhi };
+            self.fill(lo, hi, stand_in + self.iso);
+            return;
+        }
+        let sizes = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        let axis = (0..3).max_by_key(|&a| sizes[a]).expect("three axes");
+        // Below a few cells a box is cheaper to sample densely (batched, vectorised evaluation)
+        // than to keep bounding (each interval query costs about as much as a dozen points).
+        if sizes[axis] <= LEAF_CELLS {
+            self.mark(lo, hi);
+            return;
+        }
+        let mid = lo[axis] + sizes[axis] / 2;
+        let (mut left_hi, mut right_lo) = (hi, lo);
+        left_hi[axis] = mid;
+        right_lo[axis] = mid;
+        self.visit(lo, left_hi);
+        self.visit(right_lo, hi);
+    }
+
+    /// Gives every point of the closed box a value of the known sign (evaluated points keep theirs).
+    fn fill(&mut self, lo: [usize; 3], hi: [usize; 3], value: f32) {
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let n = self.grid.index(i, j, k);
+                    if self.values[n].is_nan() {
+                        self.values[n] = value;
+                    }
+                }
+            }
+        }
+    }
+
+    fn mark(&mut self, lo: [usize; 3], hi: [usize; 3]) {
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let n = self.grid.index(i, j, k);
+                    self.marked[n] = true;
+                }
+            }
+        }
+    }
+
+    /// Evaluates the marked points in batches (they overwrite stand-ins) and checks them.
+    fn finish(mut self) -> Result<CrustSamples, Error> {
+        let indices: Vec<usize> = (0..self.marked.len()).filter(|&n| self.marked[n]).collect();
+        let mut points = Vec::with_capacity(256);
+        let mut out = vec![0.0f32; 256];
+        for chunk in indices.chunks(256) {
+            points.clear();
+            points.extend(chunk.iter().map(|&n| {
+                let [i, j, k] = self.grid.unindex(n);
+                self.grid.position(i, j, k)
+            }));
+            self.field.values(&points, &mut out[..chunk.len()]);
+            for (&n, &v) in chunk.iter().zip(&out) {
+                self.values[n] = v;
+            }
+        }
+        crate::field::check_finite(&self.values, self.grid)?;
+        Ok(CrustSamples {
+            values: self.values,
+            evaluated: indices.len(),
+            interval_queries: self.interval_queries,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::compile;
+    use crate::field::sample_grid;
+    use crate::tables::CORNERS;
+    use glam::Vec3;
+
+    #[test]
+    fn crust_values_agree_in_sign_everywhere_and_exactly_near_the_surface() {
+        let field = compile("max(box(.6, .6, .6), .75 - length(x, y, z))").unwrap();
+        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), 48).unwrap();
+        let crust = sample_crust(&field, &grid, 0.0).unwrap().unwrap();
+        let full = sample_grid(&field, &grid).unwrap();
+        assert!(crust.evaluated * 3 < full.len(), "{} of {} evaluated", crust.evaluated, full.len());
+        for (n, (&c, &f)) in crust.values.iter().zip(&full).enumerate() {
+            assert_eq!(c < 0.0, f < 0.0, "point {n}: sign differs ({c} vs {f})");
+        }
+        // Every corner of every cell the surface crosses was evaluated exactly.
+        let mut crossed = 0;
+        for k in 0..grid.cells[2] {
+            for j in 0..grid.cells[1] {
+                for i in 0..grid.cells[0] {
+                    let corners = CORNERS.map(|[a, b, c]| grid.index(i + a, j + b, k + c));
+                    let inside = corners.iter().filter(|&&n| full[n] < 0.0).count();
+                    if inside == 0 || inside == 8 {
+                        continue;
+                    }
+                    crossed += 1;
+                    for n in corners {
+                        assert_eq!(crust.values[n], full[n], "point {n}");
+                    }
+                }
+            }
+        }
+        assert!(crossed > 1000);
+    }
+
+    #[test]
+    fn fields_without_intervals_are_left_to_the_uniform_grid() {
+        let grid = Grid::new(Vec3::ZERO, Vec3::ONE, [2, 2, 2]).unwrap();
+        assert!(sample_crust(&|p: Vec3| p.x - 0.5, &grid, 0.0).is_none());
+    }
+}
