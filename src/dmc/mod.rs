@@ -130,9 +130,9 @@ impl DmcStats {
     pub fn phases(&self) -> Vec<(String, f64)> {
         vec![
             ("octree".to_string(), self.octree_ms),
-            ("features".to_string(), self.features_ms),
+            ("feature_isolation".to_string(), self.features_ms),
             ("topology".to_string(), self.topology_ms),
-            ("contour".to_string(), self.contour_ms),
+            ("contouring".to_string(), self.contour_ms),
         ]
     }
 }
