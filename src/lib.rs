@@ -7,12 +7,15 @@
 //!   gradients, interval bounds, batches).
 //! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
+//! - [`emc`]: Extended Marching Cubes (sharp features on the MC grid).
+//! - [`dmc`]: Dual Marching Cubes (an octree adapted to the field, contoured on its dual grid).
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
 //!
 //! The algorithm core knows nothing of JavaScript; `wasm` (only on wasm32) is a thin binding layer.
 
+pub mod dmc;
 pub mod emc;
 pub mod error;
 pub mod expr;

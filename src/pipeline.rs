@@ -1,6 +1,7 @@
 //! From a request (method, resolution, options) to a mesh and its stats: the one path the CLI, the
 //! wasm bindings and the benches share, so the three can never disagree about what a request means.
 
+use crate::dmc::{self, DmcOptions, DmcStats};
 use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
 use crate::expr::{self, Program};
@@ -18,15 +19,17 @@ pub enum Method {
     #[default]
     Mc,
     Emc,
+    Dmc,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 2] = ["mc", "emc"];
+    pub const NAMES: [&'static str; 3] = ["mc", "emc", "dmc"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
             "mc" => Ok(Method::Mc),
             "emc" => Ok(Method::Emc),
+            "dmc" => Ok(Method::Dmc),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -39,6 +42,7 @@ impl Method {
         match self {
             Method::Mc => "mc",
             Method::Emc => "emc",
+            Method::Dmc => "dmc",
         }
     }
 }
@@ -64,6 +68,14 @@ pub struct Request {
     /// Sampled volumes only: which gradient stands in for the true surface's normals in the
     /// error statistics (see [`SampleGradient`]).
     pub gradient: SampleGradient,
+    /// DMC: error tolerance as a fraction of the bounds' longest side (see [`DmcOptions`]).
+    pub tolerance: f32,
+    /// DMC: deepest octree level; `None` takes the shallowest whose finest cells are no larger than
+    /// `res` cells along the longest side would be, so `res` means the same finest cell for all
+    /// methods.
+    pub max_depth: Option<u8>,
+    /// DMC: QEF samples per cell along each axis.
+    pub samples_per_cell: usize,
 }
 
 impl Default for Request {
@@ -80,6 +92,9 @@ impl Default for Request {
             phi_corner: 0.7,
             directed: true,
             gradient: SampleGradient::default(),
+            tolerance: DmcOptions::default().tolerance,
+            max_depth: None,
+            samples_per_cell: DmcOptions::default().samples_per_cell,
         }
     }
 }
@@ -87,6 +102,31 @@ impl Default for Request {
 impl Request {
     fn mc_options(&self) -> McOptions {
         McOptions { iso: self.iso, topology: self.topology, max_cells: self.max_cells }
+    }
+
+    fn dmc_options(&self) -> DmcOptions {
+        DmcOptions {
+            iso: self.iso,
+            tolerance: self.tolerance,
+            max_depth: self.depth(),
+            samples_per_cell: self.samples_per_cell,
+            max_cells: self.max_cells,
+            ..DmcOptions::default()
+        }
+    }
+
+    /// The octree depth DMC runs at (see [`Request::max_depth`]), saturating past any valid depth so
+    /// that validation reports it.
+    fn depth(&self) -> u8 {
+        self.max_depth.unwrap_or_else(|| self.res.max(1).next_power_of_two().trailing_zeros().min(255) as u8)
+    }
+
+    /// The `res` reported: cells along the longest side at the finest level (DMC: `2^depth`).
+    fn reported_res(&self) -> usize {
+        match self.method {
+            Method::Dmc => 1usize.checked_shl(self.depth() as u32).unwrap_or(usize::MAX),
+            _ => self.res,
+        }
     }
 
     fn emc_options(&self) -> EmcOptions {
@@ -121,17 +161,34 @@ struct Meshed {
     feature_counts: [usize; 3],
     /// Points evaluated and grid points (EMC).
     evaluations: Option<(usize, usize)>,
+    /// Octree leaves and dual cells (DMC).
+    octree: Option<(usize, usize)>,
 }
 
 impl Meshed {
     fn plain(mesh: Mesh, phases: Vec<(String, f64)>) -> Meshed {
-        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3], evaluations: None }
+        Meshed {
+            mesh,
+            feature_edges: vec![],
+            phases,
+            feature_counts: [0; 3],
+            evaluations: None,
+            octree: None,
+        }
+    }
+
+    fn from_dmc(mesh: Mesh, stats: DmcStats) -> Meshed {
+        Meshed {
+            octree: Some((stats.octree_leaves, stats.dual_cells)),
+            ..Meshed::plain(mesh, stats.phases())
+        }
     }
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
         Meshed {
             feature_counts: [out.edge_features, out.corner_features, out.flips],
             evaluations: Some((out.points_evaluated, out.grid_points)),
+            octree: None,
             phases: timings.phases(),
             mesh: out.mesh,
             feature_edges: out.feature_edges,
@@ -143,6 +200,8 @@ impl Meshed {
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
         stats.points_evaluated = self.evaluations.map(|e| e.0);
         stats.grid_points = self.evaluations.map(|e| e.1);
+        stats.octree_leaves = self.octree.map(|o| o.0);
+        stats.dual_cells = self.octree.map(|o| o.1);
         Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
     }
 }
@@ -151,19 +210,25 @@ impl Meshed {
 pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error> {
     let (min, max) = request.bounds.unwrap_or(bounds);
     let grid = Grid::with_resolution(min, max, request.res)?;
-    grid.check_size(request.max_cells)?;
     let meshed = match request.method {
         Method::Mc => {
+            grid.check_size(request.max_cells)?;
             let (mesh, timings) = mc::mesh_field(field, &grid, &request.mc_options())?;
             Meshed::plain(mesh, timings.phases())
         }
         Method::Emc => {
+            grid.check_size(request.max_cells)?;
             let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
+        // The octree bounds its own size (`max_cells` leaves); `res` only picks the default depth.
+        Method::Dmc => {
+            let (mesh, stats) = dmc::mesh_field(field, min, max, &request.dmc_options())?;
+            Meshed::from_dmc(mesh, stats)
+        }
     };
     let shifted = Shifted { field, iso: request.iso };
-    Ok(meshed.analyse(request.method, request.res, &shifted, request.analysis))
+    Ok(meshed.analyse(request.method, request.reported_res(), &shifted, request.analysis))
 }
 
 /// Where programs (typed or CSG) are meshed unless the request names bounds: [-1, 1]³.
@@ -204,10 +269,24 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
+        // DMC samples the trilinear interpolant like any other field (the QEF needs values
+        // between the samples); its depth defaults to the volume's own resolution.
+        Method::Dmc => {
+            crate::field::check_finite(values, grid)?;
+            let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
+            let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
+            let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
+            Meshed::from_dmc(mesh, stats)
+        }
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
-    let res = grid.cells.iter().copied().max().unwrap_or(0);
+    let res = match request.method {
+        Method::Dmc => {
+            Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() }.reported_res()
+        }
+        _ => grid.cells.iter().copied().max().unwrap_or(0),
+    };
     Ok(meshed.analyse(request.method, res, &shifted, request.analysis))
 }
 

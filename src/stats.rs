@@ -69,6 +69,9 @@ pub struct Stats {
     /// Grid points where the field was evaluated (EMC's crust skips the rest), and the grid's size.
     pub points_evaluated: Option<usize>,
     pub grid_points: Option<usize>,
+    /// Leaves of the final octree, and dual cells traversed (DMC).
+    pub octree_leaves: Option<usize>,
+    pub dual_cells: Option<usize>,
 }
 
 impl Stats {

@@ -23,8 +23,11 @@ fn start() {
 
 #[wasm_bindgen(typescript_custom_section)]
 const TS_TYPES: &'static str = r#"
-/** Meshing method: Marching Cubes, or Extended Marching Cubes (keeps sharp edges and corners). */
-export type Method = "mc" | "emc";
+/**
+ * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), or Dual
+ * Marching Cubes (adaptive octree: sharp features and thin walls with few triangles).
+ */
+export type Method = "mc" | "emc" | "dmc";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
 /** Sample type of a volume given to meshGrid as raw little-endian bytes. */
@@ -57,6 +60,12 @@ export interface MeshOptions {
   phiCorner?: number;
   /** EMC: exact edge crossings by root finding (default true) rather than linear interpolation. */
   directed?: boolean;
+  /** DMC: error tolerance as a fraction of the bounds' longest side (default 0.001). */
+  tolerance?: number;
+  /** DMC: deepest octree level (default: the depth whose finest cells match res). */
+  maxDepth?: number;
+  /** DMC: QEF samples per cell along each axis, 2 to 16 (default 4). */
+  samplesPerCell?: number;
 }
 
 /** Options of meshGrid: the shared ones plus the sample type. */
@@ -107,6 +116,10 @@ export interface MeshStats {
   ms_analysis: number;
   /** EMC: mesh edges on feature lines, cells with an edge / corner feature, edges flipped (0 for MC). */
   feature_edges: number; edge_features: number; corner_features: number; flips: number;
+  /** EMC: grid points evaluated and the grid's points (null for other methods). */
+  points_evaluated: number | null; grid_points: number | null;
+  /** DMC: leaves of the final octree and dual cells traversed (null for other methods). */
+  octree_leaves: number | null; dual_cells: number | null;
 }
 
 /** A mesh ready for WebGL / three.js: `positions` and `normals` are xyz triples, `indices` triangles (CCW = outward). */
@@ -157,6 +170,9 @@ struct JsOptions {
     theta_sharp: Option<f32>,
     phi_corner: Option<f32>,
     directed: Option<bool>,
+    tolerance: Option<f32>,
+    max_depth: Option<f64>,
+    samples_per_cell: Option<f64>,
     dtype: Option<String>,
     gradient: Option<String>,
 }
@@ -226,6 +242,22 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool)
     r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);
     r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
     r.directed = o.directed.unwrap_or(r.directed);
+    r.tolerance = o.tolerance.unwrap_or(r.tolerance);
+    let whole = |name: &str, v: f64, max: f64| {
+        if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= max {
+            Ok(v)
+        } else {
+            Err(js_error(Error::InvalidOption(format!(
+                "{name} must be a whole number in 0..={max}, got {v}"
+            ))))
+        }
+    };
+    if let Some(d) = o.max_depth {
+        r.max_depth = Some(whole("maxDepth", d, 255.0)? as u8);
+    }
+    if let Some(n) = o.samples_per_cell {
+        r.samples_per_cell = whole("samplesPerCell", n, 1e6)? as usize;
+    }
     if let Some(g) = &o.gradient {
         r.gradient = SampleGradient::parse(g).map_err(js_error)?;
     }

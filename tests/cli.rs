@@ -209,3 +209,22 @@ fn output_files_follow_their_extension() {
         fails(&["mesh", "--scene", "torus", "--res", "8", "-o", scratch("torus.xyz").to_str().unwrap()]);
     assert!(!err.is_empty());
 }
+
+#[test]
+fn dmc_reports_its_octree_and_phases() {
+    let s = stats(&["mesh", "--scene", "torus", "--method", "dmc", "--tol", "0.002", "--max-depth", "5"]);
+    assert_eq!(s["method"], "dmc");
+    assert_eq!(s["res"], 32, "2^max_depth finest cells");
+    assert_eq!(s["closed_manifold"], true);
+    assert_eq!(s["euler"], 0);
+    assert_eq!(s["self_intersections"], 0);
+    assert!(s["octree_leaves"].as_u64().unwrap() > 0 && s["dual_cells"].as_u64().unwrap() > 0, "{s}");
+    // serde_json's map sorts keys here; the order the phases ran in is the JSON text's.
+    let phases: Vec<&String> = s["phases_ms"].as_object().unwrap().keys().collect();
+    assert_eq!(phases, ["contouring", "feature_isolation", "octree", "topology"]);
+    assert!(s["points_evaluated"].is_null(), "an EMC key, kept and null");
+    let loose = stats(&["mesh", "--scene", "torus", "--method", "dmc", "--tol", "0.02", "--max-depth", "5"]);
+    assert!(loose["triangles"].as_u64() < s["triangles"].as_u64(), "a looser tolerance simplifies more");
+    let err = fails(&["mesh", "--scene", "torus", "--method", "dmc", "--samples-per-cell", "1"]);
+    assert!(err.contains("samplesPerCell"), "{err}");
+}

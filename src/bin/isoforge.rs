@@ -61,7 +61,7 @@ struct MeshArgs {
     /// Position of the first --grid sample [default: 0,0,0].
     #[arg(long, value_parser = list::<f32, 3>, value_name = "X,Y,Z", allow_hyphen_values = true, conflicts_with_all = NOT_GRID)]
     origin: Option<[f32; 3]>,
-    /// Meshing method: mc (Marching Cubes) or emc (Extended Marching Cubes).
+    /// Meshing method: mc (Marching Cubes), emc (Extended Marching Cubes) or dmc (Dual Marching Cubes).
     #[arg(long, default_value = "mc")]
     method: String,
     /// Cells along the longest side of the bounds (a --grid has its own).
@@ -97,6 +97,16 @@ struct MeshArgs {
     /// EMC: place edge crossings by linear interpolation instead of exact root finding.
     #[arg(long)]
     no_directed: bool,
+    /// DMC: error tolerance as a fraction of the bounds' longest side (QEF residual and triangle
+    /// distance to the surface).
+    #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().tolerance)]
+    tol: f32,
+    /// DMC: deepest octree level [default: the depth whose finest cells match --res].
+    #[arg(long)]
+    max_depth: Option<u8>,
+    /// DMC: QEF samples per cell along each axis.
+    #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().samples_per_cell)]
+    samples_per_cell: usize,
     /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
     /// central differences at the samples interpolated (continuous across cells) [default: central].
     #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
@@ -162,6 +172,9 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
             Some(GradientArg::Trilinear) => SampleGradient::Trilinear,
             Some(GradientArg::Central) | None => SampleGradient::CentralDifferences,
         },
+        tolerance: args.tol,
+        max_depth: args.max_depth,
+        samples_per_cell: args.samples_per_cell,
     };
     let out = mesh_input(&args, &request)?;
     if let Some(path) = &args.output {

@@ -1,0 +1,180 @@
+//! The second half of sliver elimination (§4). A dual vertex on (or very near) the surface makes
+//! every crossing on its dual edges land next to it, and Marching Cubes then fans tiny, thin
+//! triangles around it. The paper lets them collapse onto the vertex; here the crossings within the
+//! tolerance of a dual vertex (and within a quarter of the edge) are merged into one mesh vertex
+//! there, and the triangles that collapse are removed.
+//!
+//! A merge is an identification of several mesh vertices, which can pinch the surface (two sheets
+//! meeting at the dual vertex). It is applied only when the merged vertex's link — the edges
+//! opposite it in its remaining triangles — is one simple cycle of at least three vertices, which is
+//! exactly the condition for the result to stay a manifold around it (and every other vertex's link
+//! stays a cycle too: a vertex seeing the group twice would appear twice in that link). It is also
+//! refused when a remaining triangle would turn over or lose its area.
+
+use super::contour::Contour;
+use super::features::DualVertices;
+use crate::field::Field;
+use glam::{DVec3, Vec3};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Merges crossings clustered around dual vertices, except around those in `skip`. Returns the
+/// number of triangles removed and, per vertex of the result, the dual vertex it was merged into
+/// (`u32::MAX` for vertices left alone).
+pub fn collapse(
+    contour: &mut Contour,
+    vertices: &DualVertices,
+    field: &dyn Field,
+    iso: f32,
+    tolerance: f32,
+    skip: &BTreeSet<u32>,
+) -> (usize, Vec<u32>) {
+    let mesh = &mut contour.mesh;
+    let mut groups: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for (v, c) in contour.crossings.iter().enumerate() {
+        let length = vertices.positions[c.inside as usize].distance(vertices.positions[c.outside as usize]);
+        if c.t <= 0.25 && c.t * length <= tolerance {
+            groups.entry(c.inside).or_default().push(v as u32);
+        } else if c.t >= 0.75 && (1.0 - c.t) * length <= tolerance {
+            groups.entry(c.outside).or_default().push(v as u32);
+        }
+    }
+    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            incident[v as usize].push(t as u32);
+        }
+    }
+    let mut alive = vec![true; mesh.triangles.len()];
+    let mut removed = 0;
+    let mut merged_into = vec![u32::MAX; mesh.positions.len()];
+    for (dual, members) in groups {
+        if members.len() < 2 || skip.contains(&dual) {
+            continue;
+        }
+        let target = project(field, iso, vertices.positions[dual as usize], tolerance);
+        let merged = members[0];
+        let is_member = |v: u32| members.contains(&v);
+        let mut touched: Vec<u32> =
+            members.iter().flat_map(|&m| incident[m as usize].iter().copied()).collect();
+        touched.sort_unstable();
+        touched.dedup();
+        touched.retain(|&t| alive[t as usize]);
+        let mut kept = Vec::new();
+        let mut dropped = Vec::new();
+        let mut ok = true;
+        for &t in &touched {
+            let old = mesh.triangles[t as usize];
+            let new = old.map(|v| if is_member(v) { merged } else { v });
+            if new[0] == new[1] || new[1] == new[2] || new[0] == new[2] {
+                dropped.push(t);
+                continue;
+            }
+            let at = |tri: [u32; 3], moved: bool| -> [DVec3; 3] {
+                tri.map(|v| {
+                    if moved && v == merged {
+                        target.as_dvec3()
+                    } else {
+                        mesh.positions[v as usize].as_dvec3()
+                    }
+                })
+            };
+            let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
+            let (before, after) = (normal(at(old, false)), normal(at(new, true)));
+            if after == DVec3::ZERO || before.dot(after) <= 0.0 {
+                ok = false;
+                break;
+            }
+            kept.push((t, new));
+        }
+        if !ok || !link_is_a_cycle(merged, &kept) {
+            continue;
+        }
+        for &t in &dropped {
+            alive[t as usize] = false;
+        }
+        removed += dropped.len();
+        for &(t, new) in &kept {
+            mesh.triangles[t as usize] = new;
+        }
+        mesh.positions[merged as usize] = target;
+        merged_into[merged as usize] = dual;
+        let all: Vec<u32> = kept.iter().map(|&(t, _)| t).collect();
+        for &m in &members {
+            incident[m as usize].clear();
+        }
+        incident[merged as usize] = all;
+    }
+    // Compact: live triangles, referenced vertices.
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len() - removed);
+    let mut cells = Vec::with_capacity(triangles.capacity());
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if alive[t] {
+            triangles.push(*tri);
+            cells.push(contour.cell_of_triangle[t]);
+        }
+    }
+    let mut new_id = vec![u32::MAX; mesh.positions.len()];
+    let (mut positions, mut crossings, mut merged) = (Vec::new(), Vec::new(), Vec::new());
+    for tri in &mut triangles {
+        for v in tri.iter_mut() {
+            if new_id[*v as usize] == u32::MAX {
+                new_id[*v as usize] = positions.len() as u32;
+                positions.push(mesh.positions[*v as usize]);
+                crossings.push(contour.crossings[*v as usize]);
+                merged.push(merged_into[*v as usize]);
+            }
+            *v = new_id[*v as usize];
+        }
+    }
+    mesh.triangles = triangles;
+    mesh.positions = positions;
+    contour.crossings = crossings;
+    contour.cell_of_triangle = cells;
+    (removed, merged)
+}
+
+/// Whether the triangles around `center` (each containing it once) form one closed fan: their
+/// opposite edges chain into a single cycle of at least three vertices.
+fn link_is_a_cycle(center: u32, triangles: &[(u32, [u32; 3])]) -> bool {
+    if triangles.len() < 3 {
+        return false;
+    }
+    let mut next: BTreeMap<u32, u32> = BTreeMap::new();
+    let mut targets = std::collections::BTreeSet::new();
+    for &(_, tri) in triangles {
+        let k = tri.iter().position(|&v| v == center).expect("triangle around the centre");
+        let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        if next.insert(a, b).is_some() || !targets.insert(b) {
+            return false;
+        }
+    }
+    let start = *next.keys().next().expect("non-empty");
+    let (mut v, mut steps) = (start, 0);
+    loop {
+        let Some(&w) = next.get(&v) else { return false };
+        steps += 1;
+        v = w;
+        if v == start {
+            break;
+        }
+        if steps > triangles.len() {
+            return false;
+        }
+    }
+    steps == triangles.len()
+}
+
+/// A few Newton steps from `p` toward the zero set, each at most `limit` long.
+fn project(field: &dyn Field, iso: f32, mut p: Vec3, limit: f32) -> Vec3 {
+    for _ in 0..3 {
+        let Some(g) = field.gradient(p) else { return p };
+        let d = field.value(p) - iso;
+        let g2 = g.length_squared();
+        if d == 0.0 || g2 < 1e-20 {
+            break;
+        }
+        let step = g * (d / g2);
+        p -= step.clamp_length_max(limit);
+    }
+    p
+}
