@@ -8,6 +8,8 @@
 //! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
+//! - [`input`]: reading triangle meshes (OBJ, STL, PLY, OFF) and oriented point clouds (PLY, XYZ)
+//!   for EMC's remeshing and surface reconstruction ([`emc::mesh_source`], [`emc::point_source`]).
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
 //!
@@ -18,6 +20,7 @@ pub mod error;
 pub mod expr;
 pub mod field;
 pub mod grid;
+pub mod input;
 pub mod mc;
 pub mod mesh;
 pub mod pipeline;
