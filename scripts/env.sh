@@ -6,6 +6,10 @@
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 export CHROMEDRIVER="${CHROMEDRIVER:-/usr/bin/chromedriver}"
+# wasm-bindgen-test-runner gives a whole suite 20 s by default; the debug-built suites (scenes at
+# res 48 with self-intersection and surface-error checks, MC at res 64) take about that on a shared
+# 2-core machine, so give them room rather than fail on load.
+export WASM_BINDGEN_TEST_TIMEOUT="${WASM_BINDGEN_TEST_TIMEOUT:-300}"
 WASM_TARGET=wasm32-unknown-unknown
 # A separate target dir keeps the two compilers' artefacts apart.
 WASM_TARGET_DIR="$ROOT/target/wasm"

@@ -1,4 +1,5 @@
-//! The sampling lattice: the single place that maps grid indices to world coordinates.
+//! The sampling lattice: the single place that maps grid indices to world coordinates, and the
+//! reader for raw sample volumes (little-endian `f32`, `u8` or `u16`, x fastest) laid out on it.
 
 use crate::error::Error;
 use glam::Vec3;
@@ -45,6 +46,23 @@ impl Grid {
         let covered = Vec3::new(cells[0] as f32, cells[1] as f32, cells[2] as f32) * h;
         let origin = (min + max) * 0.5 - covered * 0.5;
         Ok(Grid { origin, spacing: Vec3::splat(h), cells })
+    }
+
+    /// A lattice of `points[a]` samples along axis `a` (at least 2), the first at `origin`, spaced
+    /// by `spacing` (positive): the layout of a raw volume file.
+    pub fn from_points(points: [usize; 3], origin: Vec3, spacing: Vec3) -> Result<Grid, Error> {
+        if points.iter().any(|&n| n < 2) {
+            return Err(Error::InvalidGrid(format!(
+                "dims must be three point counts, each at least 2, got {} x {} x {}",
+                points[0], points[1], points[2]
+            )));
+        }
+        if !(origin.is_finite() && spacing.is_finite() && spacing.cmpgt(Vec3::ZERO).all()) {
+            return Err(Error::InvalidGrid(format!(
+                "origin must be finite and spacing positive, got origin {origin}, spacing {spacing}"
+            )));
+        }
+        Ok(Grid { origin, spacing, cells: points.map(|n| n - 1) })
     }
 
     /// Sample points per axis.
@@ -100,6 +118,80 @@ impl Grid {
     }
 }
 
+/// The element type of raw samples. Integer samples become `f32` of the same value (no scaling),
+/// so an iso-level for `u8` data is given in 0..=255.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Dtype {
+    #[default]
+    F32,
+    U8,
+    U16,
+}
+
+impl Dtype {
+    pub const NAMES: [&'static str; 3] = ["f32", "u8", "u16"];
+
+    pub fn parse(name: &str) -> Result<Dtype, Error> {
+        match name {
+            "f32" => Ok(Dtype::F32),
+            "u8" => Ok(Dtype::U8),
+            "u16" => Ok(Dtype::U16),
+            _ => Err(Error::UnknownName {
+                kind: "dtype",
+                name: name.to_string(),
+                known: Self::NAMES.iter().map(|s| s.to_string()).collect(),
+            }),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Dtype::F32 => "f32",
+            Dtype::U8 => "u8",
+            Dtype::U16 => "u16",
+        }
+    }
+
+    /// Bytes per sample.
+    pub fn size(self) -> usize {
+        match self {
+            Dtype::F32 => 4,
+            Dtype::U8 => 1,
+            Dtype::U16 => 2,
+        }
+    }
+}
+
+/// Decodes a raw volume: little-endian samples of type `dtype`, x fastest, exactly one per point
+/// of `grid` (a wrong byte count is an error naming both counts, since a guessed layout would
+/// mesh garbage). NaN and infinite `f32` samples are left for the mesher to report by position.
+pub fn samples_from_bytes(bytes: &[u8], dtype: Dtype, grid: &Grid) -> Result<Vec<f32>, Error> {
+    let [nx, ny, nz] = grid.points();
+    let expected = grid.point_count() as u64 * dtype.size() as u64;
+    if bytes.len() as u64 != expected {
+        return Err(Error::InvalidGrid(format!(
+            "{nx} x {ny} x {nz} {} samples take {expected} bytes, got {}",
+            dtype.name(),
+            bytes.len()
+        )));
+    }
+    Ok(match dtype {
+        Dtype::F32 => bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect(),
+        Dtype::U8 => samples_from_u8(bytes),
+        Dtype::U16 => bytes.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]]) as f32).collect(),
+    })
+}
+
+/// `u8` samples as `f32` of the same value.
+pub fn samples_from_u8(values: &[u8]) -> Vec<f32> {
+    values.iter().map(|&v| v as f32).collect()
+}
+
+/// `u16` samples as `f32` of the same value (exact: every `u16` is an `f32`).
+pub fn samples_from_u16(values: &[u16]) -> Vec<f32> {
+    values.iter().map(|&v| v as f32).collect()
+}
+
 fn check_bounds(min: Vec3, max: Vec3) -> Result<(), Error> {
     if !(min.is_finite() && max.is_finite()) {
         return Err(Error::InvalidGrid(format!("bounds must be finite, got {min} .. {max}")));
@@ -131,6 +223,27 @@ mod tests {
             let [i, j, k] = g.unindex(n);
             assert_eq!(g.index(i, j, k), n);
         }
+    }
+
+    #[test]
+    fn raw_volumes_decode_little_endian_x_fastest() {
+        let grid = Grid::from_points([3, 2, 2], Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 1.0, 2.0)).unwrap();
+        assert_eq!(grid.cells, [2, 1, 1]);
+        assert_eq!(grid.max(), Vec3::new(2.0, 3.0, 5.0));
+        let u8s: Vec<u8> = (0..12).collect();
+        assert_eq!(samples_from_bytes(&u8s, Dtype::U8, &grid).unwrap()[grid.index(2, 1, 0)], 5.0);
+        let u16s: Vec<u8> = (0..12u16).flat_map(|v| (v * 300).to_le_bytes()).collect();
+        assert_eq!(samples_from_bytes(&u16s, Dtype::U16, &grid).unwrap()[11], 3300.0);
+        let f32s: Vec<u8> = (0..12).flat_map(|v| (v as f32 - 0.5).to_le_bytes()).collect();
+        let values = samples_from_bytes(&f32s, Dtype::F32, &grid).unwrap();
+        assert_eq!(values[0], -0.5);
+        assert_eq!(values[11], 10.5);
+        let err = samples_from_bytes(&u16s[..23], Dtype::U16, &grid).unwrap_err().to_string();
+        assert_eq!(err, "invalid grid: 3 x 2 x 2 u16 samples take 24 bytes, got 23");
+        assert_eq!(Dtype::parse("u16"), Ok(Dtype::U16));
+        assert!(Dtype::parse("i16").unwrap_err().to_string().contains("known: f32, u8, u16"));
+        assert!(Grid::from_points([1, 2, 2], Vec3::ZERO, Vec3::ONE).is_err());
+        assert!(Grid::from_points([2, 2, 2], Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)).is_err());
     }
 
     #[test]

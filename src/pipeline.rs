@@ -3,10 +3,12 @@
 
 use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
-use crate::field::{Field, SampledField};
+use crate::expr::{self, Program};
+use crate::field::{BatchFn, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mesh::Mesh;
+use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
 
@@ -59,6 +61,9 @@ pub struct Request {
     pub phi_corner: f32,
     /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
     pub directed: bool,
+    /// Sampled volumes only: which gradient stands in for the true surface's normals in the
+    /// error statistics (see [`SampleGradient`]).
+    pub gradient: SampleGradient,
 }
 
 impl Default for Request {
@@ -74,6 +79,7 @@ impl Default for Request {
             theta_sharp: 0.9,
             phi_corner: 0.7,
             directed: true,
+            gradient: SampleGradient::default(),
         }
     }
 }
@@ -160,8 +166,34 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
     Ok(meshed.analyse(request.method, request.res, &shifted, request.analysis))
 }
 
+/// Where programs (typed or CSG) are meshed unless the request names bounds: [-1, 1]³.
+pub const DEFAULT_BOUNDS: (Vec3, Vec3) = (Vec3::splat(-1.0), Vec3::splat(1.0));
+
+/// Meshes a built-in scene (see [`scenes::SCENE_NAMES`]) in its own bounds.
+pub fn mesh_scene(name: &str, request: &Request) -> Result<Output, Error> {
+    let scene = scenes::scene(name)?;
+    mesh_field(scene.field.as_ref(), (scene.min, scene.max), request)
+}
+
+/// Meshes a compiled program over the request's bounds, or [`DEFAULT_BOUNDS`].
+pub fn mesh_program(program: &Program, request: &Request) -> Result<Output, Error> {
+    mesh_field(program, DEFAULT_BOUNDS, request)
+}
+
+/// Compiles a program in the expression language and meshes it like [`mesh_program`]. A
+/// malformed program fails with [`Error::Parse`] (line, column and a caret under the spot).
+pub fn mesh_expr(text: &str, request: &Request) -> Result<Output, Error> {
+    mesh_program(&expr::compile(text)?, request)
+}
+
+/// Compiles a CSG tree in JSON (see [`crate::expr::csg`]) and meshes it like [`mesh_program`].
+pub fn mesh_csg_json(json: &str, request: &Request) -> Result<Output, Error> {
+    mesh_program(&Program::from_csg_json(json)?, request)
+}
+
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
-/// the samples stands in for the true surface in the error statistics.
+/// the samples stands in for the true surface in the error statistics, its normals given by
+/// `request.gradient` (trilinear or interpolated central differences, see [`SampleGradient`]).
 pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Output, Error> {
     let meshed = match request.method {
         Method::Mc => {
@@ -173,10 +205,25 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             Meshed::from_emc(out, timings)
         }
     };
-    let field = SampledField { grid: *grid, values };
+    let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
     let res = grid.cells.iter().copied().max().unwrap_or(0);
     Ok(meshed.analyse(request.method, res, &shifted, request.analysis))
+}
+
+/// Meshes a batch field function (the slow path for functions that are costly to call, such as
+/// JavaScript ones): the closure samples the grid over `bounds` (or the request's) one z-slab per
+/// call, then the samples are meshed like [`mesh_samples`], gradients by central differences.
+pub fn mesh_function<F>(field: &BatchFn<F>, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error>
+where
+    F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>,
+{
+    let (min, max) = request.bounds.unwrap_or(bounds);
+    let grid = Grid::with_resolution(min, max, request.res)?;
+    grid.check_size(request.max_cells)?;
+    let values = field.sample(&grid)?;
+    let request = Request { gradient: SampleGradient::CentralDifferences, ..request.clone() };
+    mesh_samples(&values, &grid, &request)
 }
 
 /// The field minus the iso-level, so "the surface" is always the zero set for the analysis.
@@ -191,5 +238,51 @@ impl Field for Shifted<'_> {
     }
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         self.field.gradient(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quick() -> Request {
+        Request {
+            res: 16,
+            analysis: AnalysisOptions { self_intersections: false, surface_error: true },
+            ..Request::default()
+        }
+    }
+
+    #[test]
+    fn text_csg_and_scene_paths_mesh_the_same_sphere() {
+        let from_text = mesh_expr("sphere(0.8)", &quick()).unwrap();
+        let from_csg = mesh_csg_json(r#"{"op": "sphere", "radius": 0.8}"#, &quick()).unwrap();
+        let from_scene = mesh_scene("sphere", &quick()).unwrap();
+        assert_eq!(
+            from_text.mesh.positions, from_scene.mesh.positions,
+            "default bounds are the scene's [-1, 1]³"
+        );
+        assert_eq!(from_csg.mesh.triangles, from_scene.mesh.triangles);
+        assert_eq!(from_text.stats.euler, 2);
+        assert!(from_text.stats.dist_max.unwrap() < 0.01);
+    }
+
+    #[test]
+    fn requested_bounds_replace_the_default_ones() {
+        let request = Request { bounds: Some((Vec3::splat(-3.0), Vec3::splat(3.0))), ..quick() };
+        let out = mesh_expr("sphere(2.5)", &request).unwrap();
+        assert!(out.stats.closed_manifold && out.stats.euler == 2);
+        let clipped = mesh_expr("sphere(2.5)", &quick()).unwrap();
+        assert_eq!(
+            clipped.stats.triangles, 0,
+            "a sphere containing the default bounds has no surface in them"
+        );
+    }
+
+    #[test]
+    fn parse_errors_come_back_with_their_position() {
+        let err = mesh_expr("union(sphere(1),\n  box(1, 2)", &quick()).unwrap_err();
+        assert!(matches!(err, Error::Parse { line: 2, .. }), "{err}");
+        assert!(err.to_string().contains('^'));
     }
 }

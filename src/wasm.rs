@@ -3,16 +3,18 @@
 //! Every failure becomes a JavaScript `Error` carrying the library's message.
 
 use crate::error::Error;
-use crate::grid::{Grid, DEFAULT_MAX_CELLS};
+use crate::expr::{self, Program};
+use crate::field::{BatchFn, SampleGradient};
+use crate::grid::{self, Dtype, Grid, DEFAULT_MAX_CELLS};
 use crate::mc::Topology;
-use crate::mesh::Mesh;
-use crate::pipeline::{self, Method, Request};
+use crate::pipeline::{self, Method, Output, Request};
 use crate::scenes;
-use crate::stats::{AnalysisOptions, Stats};
+use crate::stats::AnalysisOptions;
 use glam::Vec3;
-use js_sys::{Float32Array, Object, Reflect, Uint32Array};
+use js_sys::{ArrayBuffer, Float32Array, Object, Reflect, Uint16Array, Uint32Array, Uint8Array};
 use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
 
 #[wasm_bindgen(start)]
 fn start() {
@@ -21,10 +23,12 @@ fn start() {
 
 #[wasm_bindgen(typescript_custom_section)]
 const TS_TYPES: &'static str = r#"
-/** Meshing method. */
-export type Method = "mc";
+/** Meshing method: Marching Cubes, or Extended Marching Cubes (keeps sharp edges and corners). */
+export type Method = "mc" | "emc";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
+/** Sample type of a volume given to meshGrid as raw little-endian bytes. */
+export type Dtype = "f32" | "u8" | "u16";
 
 /** Options shared by every mesh function. Unknown keys are an error, so typos do not pass silently. */
 export interface MeshOptions {
@@ -38,13 +42,47 @@ export interface MeshOptions {
   topology?: Topology;
   /** Refuse grids with more cells than this (default 72 000 000). */
   maxCells?: number;
-  /** [x0, y0, z0, x1, y1, z1]: mesh this box instead of the input's own bounds. Ignored by meshGrid. */
+  /**
+   * [x0, y0, z0, x1, y1, z1]: mesh this box instead of the input's own bounds (a scene's, or
+   * [-1, 1]³ for shapes, expressions and CSG trees). Ignored by meshGrid.
+   */
   bounds?: [number, number, number, number, number, number];
   /** Run the pairwise self-intersection check (default false: it is the costliest check). */
   checkIntersections?: boolean;
   /** Measure distance and normal deviation against the true surface (default true). */
   surfaceError?: boolean;
+  /** EMC: a cell is sharp when the smallest dot product of its normals is below this cosine (default 0.9). */
+  thetaSharp?: number;
+  /** EMC: a sharp cell holds a corner when max |n·n*| exceeds this cosine (default 0.7). */
+  phiCorner?: number;
+  /** EMC: exact edge crossings by root finding (default true) rather than linear interpolation. */
+  directed?: boolean;
 }
+
+/** Options of meshGrid: the shared ones plus the sample type. */
+export interface GridOptions extends MeshOptions {
+  /**
+   * Sample type. Inferred from a Float32Array, Uint8Array or Uint16Array; with a Uint8Array or an
+   * ArrayBuffer of raw little-endian bytes (a .raw file), "f32" and "u16" reinterpret the bytes.
+   */
+  dtype?: Dtype;
+  /**
+   * The volume's gradient, used for the normals of the surface-error statistics (default
+   * "central"): central differences at the samples interpolated (continuous across cells) or
+   * the trilinear interpolant's own (consistent with it, but it jumps at every cell face).
+   */
+  gradient?: SampleGradientName;
+}
+
+/** Which gradient a sampled volume reports: see GridOptions.gradient. */
+export type SampleGradientName = "trilinear" | "central";
+
+/**
+ * A field given as a JavaScript function for meshFunction: called with a batch of points as xyz
+ * triples (one z-slab of the grid per call, never one point at a time), it returns one value per
+ * point, negative inside.
+ */
+export type BatchFieldFunction = (points: Float32Array) => Float32Array | number[];
 
 /** Numbers describing one run; the same keys as the CLI's `--stats` JSON. */
 export interface MeshStats {
@@ -61,6 +99,8 @@ export interface MeshStats {
   /** Milliseconds per phase, in the order the phases ran. */
   phases_ms: Record<string, number>;
   ms_analysis: number;
+  /** EMC: mesh edges on feature lines, cells with an edge / corner feature, edges flipped (0 for MC). */
+  feature_edges: number; edge_features: number; corner_features: number; flips: number;
 }
 
 /** A mesh ready for WebGL / three.js: `positions` and `normals` are xyz triples, `indices` triangles (CCW = outward). */
@@ -68,8 +108,33 @@ export interface MeshResult {
   positions: Float32Array;
   normals: Float32Array;
   indices: Uint32Array;
+  /** Sharp feature lines found by EMC as pairs of vertex indices (empty for MC): draw with gl.LINES. */
+  featureEdges: Uint32Array;
   stats: MeshStats;
 }
+
+/**
+ * A shape tree for meshCsg / compileCsg. Each node means the language function of the same name;
+ * see the README's "Language" section. Unknown fields are an error.
+ */
+export type CsgNode =
+  | { op: "sphere"; radius: number }
+  | { op: "box"; half: [number, number, number] }
+  | { op: "rounded_box"; half: [number, number, number]; radius: number }
+  | { op: "cylinder"; radius: number; half_height: number }
+  | { op: "cone"; radius: number; height: number }
+  | { op: "torus"; major: number; minor: number }
+  | { op: "capsule"; a: [number, number, number]; b: [number, number, number]; radius: number }
+  | { op: "plane"; normal: [number, number, number]; distance: number }
+  | { op: "union" | "intersect"; args: CsgNode[] }
+  | { op: "subtract"; args: [CsgNode, CsgNode] }
+  | { op: "smooth_union" | "smooth_intersect" | "smooth_subtract"; args: [CsgNode, CsgNode]; k: number }
+  | { op: "shell"; shape: CsgNode; thickness: number }
+  | { op: "offset"; shape: CsgNode; distance: number }
+  | { op: "translate"; shape: CsgNode; offset: [number, number, number] }
+  | { op: "rotate"; shape: CsgNode; axis: [number, number, number]; degrees: number }
+  | { op: "scale"; shape: CsgNode; factor: number }
+  | { op: "mirror_x" | "mirror_y" | "mirror_z"; shape: CsgNode };
 "#;
 
 #[derive(Deserialize, Default)]
@@ -83,16 +148,35 @@ struct JsOptions {
     bounds: Option<Vec<f32>>,
     check_intersections: Option<bool>,
     surface_error: Option<bool>,
+    theta_sharp: Option<f32>,
+    phi_corner: Option<f32>,
+    directed: Option<bool>,
+    dtype: Option<String>,
+    gradient: Option<String>,
 }
 
 fn js_error(e: impl std::fmt::Display) -> JsValue {
     js_sys::Error::new(&e.to_string()).into()
 }
 
+/// Options of every function but meshGrid, which alone takes a `dtype`.
 fn parse_options(options: JsValue) -> Result<Request, JsValue> {
+    let (request, dtype, gradient_given) = parse_grid_options(options)?;
+    if dtype.is_some() {
+        return Err(js_error(Error::InvalidOption("dtype is an option of meshGrid only".into())));
+    }
+    if gradient_given {
+        return Err(js_error(Error::InvalidOption("gradient is an option of meshGrid only".into())));
+    }
+    Ok(request)
+}
+
+/// The request, the dtype, and whether a `gradient` was given.
+fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool), JsValue> {
     let o: JsOptions = if options.is_undefined() || options.is_null() {
         JsOptions::default()
     } else {
+        check_keys(&options)?;
         serde_wasm_bindgen::from_value(options).map_err(|e| js_error(format!("invalid options: {e}")))?
     };
     let mut r = Request::default();
@@ -132,7 +216,31 @@ fn parse_options(options: JsValue) -> Result<Request, JsValue> {
         self_intersections: o.check_intersections.unwrap_or(false),
         surface_error: o.surface_error.unwrap_or(true),
     };
-    Ok(r)
+    // Ranges are checked by the method itself, with the same names.
+    r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);
+    r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
+    r.directed = o.directed.unwrap_or(r.directed);
+    if let Some(g) = &o.gradient {
+        r.gradient = SampleGradient::parse(g).map_err(js_error)?;
+    }
+    let dtype = o.dtype.as_deref().map(Dtype::parse).transpose().map_err(js_error)?;
+    Ok((r, dtype, o.gradient.is_some()))
+}
+
+/// Refuses keys `JsOptions` does not have. serde-wasm-bindgen reads a struct by looking up its
+/// fields by name, so `deny_unknown_fields` never sees the others; here serde itself checks the
+/// object's keys (each paired with `()`, which every `Option` field accepts as `None`), so the
+/// message lists the known options.
+fn check_keys(options: &JsValue) -> Result<(), JsValue> {
+    if !options.is_object() {
+        return Err(js_error(Error::InvalidOption("options must be an object".into())));
+    }
+    let names: Vec<String> =
+        Object::keys(options.unchecked_ref::<Object>()).iter().filter_map(|k| k.as_string()).collect();
+    let keys = serde::de::value::MapDeserializer::<_, serde::de::value::Error>::new(
+        names.into_iter().map(|k| (k, ())),
+    );
+    JsOptions::deserialize(keys).map(|_| ()).map_err(|e| js_error(format!("invalid options: {e}")))
 }
 
 fn parse_bounds(b: &[f32]) -> Result<(Vec3, Vec3), JsValue> {
@@ -145,15 +253,17 @@ fn parse_bounds(b: &[f32]) -> Result<(Vec3, Vec3), JsValue> {
     Ok((Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5])))
 }
 
-fn to_js(mesh: &Mesh, stats: &Stats) -> Result<JsValue, JsValue> {
-    let out = Object::new();
-    let set = |k: &str, v: &JsValue| Reflect::set(&out, &JsValue::from_str(k), v).map(|_| ());
-    set("positions", &Float32Array::from(&mesh.flat_positions()[..]).into())?;
-    set("normals", &Float32Array::from(&mesh.flat_normals()[..]).into())?;
-    set("indices", &Uint32Array::from(&mesh.flat_indices()[..]).into())?;
+fn to_js(out: &Output) -> Result<JsValue, JsValue> {
+    let result = Object::new();
+    let set = |k: &str, v: &JsValue| Reflect::set(&result, &JsValue::from_str(k), v).map(|_| ());
+    set("positions", &Float32Array::from(&out.mesh.flat_positions()[..]).into())?;
+    set("normals", &Float32Array::from(&out.mesh.flat_normals()[..]).into())?;
+    set("indices", &Uint32Array::from(&out.mesh.flat_indices()[..]).into())?;
+    let features: Vec<u32> = out.feature_edges.iter().flatten().copied().collect();
+    set("featureEdges", &Uint32Array::from(&features[..]).into())?;
     let serializer = serde_wasm_bindgen::Serializer::json_compatible();
-    set("stats", &stats.serialize(&serializer).map_err(js_error)?)?;
-    Ok(out.into())
+    set("stats", &out.stats.serialize(&serializer).map_err(js_error)?)?;
+    Ok(result.into())
 }
 
 /// Names of the built-in scenes.
@@ -166,6 +276,24 @@ pub fn scene_names() -> JsValue {
     arr.into()
 }
 
+/// A built-in scene's program in the expression language (for an editor: change it, then
+/// `meshExpr` it with `{ bounds: sceneBounds(name) }`). Throws on unknown names.
+#[wasm_bindgen(js_name = sceneSource)]
+pub fn scene_source(name: &str) -> Result<String, JsValue> {
+    scenes::source(name).map(str::to_string).map_err(js_error)
+}
+
+/// The box a built-in scene is meshed in, `[x0, y0, z0, x1, y1, z1]`. Throws on unknown names.
+#[wasm_bindgen(js_name = sceneBounds, unchecked_return_type = "[number, number, number, number, number, number]")]
+pub fn scene_bounds(name: &str) -> Result<JsValue, JsValue> {
+    let scene = scenes::scene(name).map_err(js_error)?;
+    let arr = js_sys::Array::new();
+    for v in scene.min.to_array().into_iter().chain(scene.max.to_array()) {
+        arr.push(&JsValue::from_f64(v as f64));
+    }
+    Ok(arr.into())
+}
+
 /// Meshes a built-in scene. Throws an `Error` naming the problem on bad options or unknown names.
 #[wasm_bindgen(js_name = meshScene, unchecked_return_type = "MeshResult")]
 pub fn mesh_scene(
@@ -173,23 +301,155 @@ pub fn mesh_scene(
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
-    let scene = scenes::scene(name).map_err(js_error)?;
-    let (mesh, stats) =
-        pipeline::mesh_field(scene.field.as_ref(), (scene.min, scene.max), &request).map_err(js_error)?;
-    to_js(&mesh, &stats)
+    to_js(&pipeline::mesh_scene(name, &request).map_err(js_error)?)
 }
 
-/// Meshes a sampled volume. `values` holds `dims[0] * dims[1] * dims[2]` samples, x fastest, at the
-/// points of a lattice spanning `bounds` = [x0, y0, z0, x1, y1, z1] (`dims` counts points, not cells).
-#[wasm_bindgen(js_name = meshGrid, unchecked_return_type = "MeshResult")]
-pub fn mesh_grid(
-    values: &[f32],
-    #[wasm_bindgen(unchecked_param_type = "[number, number, number] | Uint32Array")] dims: Vec<u32>,
-    #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
-    bounds: Vec<f32>,
+/// A compiled program in the expression language, reusable across meshing calls: compile once,
+/// then mesh it at several resolutions or with several methods. Free it with `free()` when done.
+#[wasm_bindgen]
+pub struct Shape {
+    program: Program,
+}
+
+#[wasm_bindgen]
+impl Shape {
+    /// The value at (x, y, z): negative inside, positive outside.
+    pub fn value(&self, x: f32, y: f32, z: f32) -> f32 {
+        self.program.eval(Vec3::new(x, y, z))
+    }
+
+    /// `[value, dx, dy, dz]` at (x, y, z): the value and its exact gradient.
+    #[wasm_bindgen(js_name = valueAndGradient)]
+    pub fn value_and_gradient(&self, x: f32, y: f32, z: f32) -> Vec<f32> {
+        let (v, g) = self.program.eval_grad(Vec3::new(x, y, z));
+        vec![v, g.x, g.y, g.z]
+    }
+
+    /// Instructions on the compiled tape (after constant folding and sharing repeated parts).
+    #[wasm_bindgen(getter, js_name = instructionCount)]
+    pub fn instruction_count(&self) -> usize {
+        self.program.instruction_count()
+    }
+}
+
+/// Compiles a program in the expression language. A malformed program throws an `Error` whose
+/// message reads `line:column: what`, then the line, then a caret under the spot.
+#[wasm_bindgen]
+pub fn compile(text: &str) -> Result<Shape, JsValue> {
+    Ok(Shape { program: expr::compile(text).map_err(js_error)? })
+}
+
+/// The JSON text of a CSG tree given as a string or as an object (pretty-printed, so that errors
+/// point at a line of it).
+fn csg_text(json: &JsValue) -> Result<String, JsValue> {
+    if let Some(text) = json.as_string() {
+        return Ok(text);
+    }
+    if !json.is_object() {
+        return Err(js_error(Error::InvalidOption("a CSG tree must be a JSON string or an object".into())));
+    }
+    let text = js_sys::JSON::stringify_with_replacer_and_space(json, &JsValue::NULL, &JsValue::from(1))?;
+    Ok(text.as_string().unwrap_or_default())
+}
+
+/// Compiles a CSG tree (a JSON string or a `CsgNode` object) into a reusable shape. Throws an
+/// `Error` pointing into the JSON on unknown ops, misspelt or missing fields.
+#[wasm_bindgen(js_name = compileCsg)]
+pub fn compile_csg(
+    #[wasm_bindgen(unchecked_param_type = "string | CsgNode")] json: JsValue,
+) -> Result<Shape, JsValue> {
+    Ok(Shape { program: Program::from_csg_json(&csg_text(&json)?).map_err(js_error)? })
+}
+
+/// Meshes a compiled shape in `options.bounds`, or [-1, 1]³.
+#[wasm_bindgen(js_name = meshShape, unchecked_return_type = "MeshResult")]
+pub fn mesh_shape(
+    shape: &Shape,
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
+    to_js(&pipeline::mesh_program(&shape.program, &request).map_err(js_error)?)
+}
+
+/// Compiles and meshes a program in the expression language, in `options.bounds` or [-1, 1]³.
+/// Parse errors throw like `compile`'s.
+#[wasm_bindgen(js_name = meshExpr, unchecked_return_type = "MeshResult")]
+pub fn mesh_expr(
+    text: &str,
+    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let request = parse_options(options)?;
+    to_js(&pipeline::mesh_expr(text, &request).map_err(js_error)?)
+}
+
+/// Compiles and meshes a CSG tree (a JSON string or a `CsgNode` object), in `options.bounds` or
+/// [-1, 1]³.
+#[wasm_bindgen(js_name = meshCsg, unchecked_return_type = "MeshResult")]
+pub fn mesh_csg(
+    #[wasm_bindgen(unchecked_param_type = "string | CsgNode")] json: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let request = parse_options(options)?;
+    to_js(&pipeline::mesh_csg_json(&csg_text(&json)?, &request).map_err(js_error)?)
+}
+
+/// The samples of a meshGrid call as `f32`, whatever array type they came in.
+fn grid_samples(values: &JsValue, dtype: Option<Dtype>, grid: &Grid) -> Result<Vec<f32>, JsValue> {
+    let mismatch = |given: &str, d: Dtype| {
+        js_error(Error::InvalidOption(format!(
+            "dtype \"{}\" does not match a {given}; pass a Uint8Array or ArrayBuffer of raw bytes to reinterpret them",
+            d.name()
+        )))
+    };
+    if let Some(a) = values.dyn_ref::<Float32Array>() {
+        match dtype {
+            None | Some(Dtype::F32) => Ok(a.to_vec()),
+            Some(d) => Err(mismatch("Float32Array", d)),
+        }
+    } else if let Some(a) = values.dyn_ref::<Uint16Array>() {
+        match dtype {
+            None | Some(Dtype::U16) => Ok(grid::samples_from_u16(&a.to_vec())),
+            Some(d) => Err(mismatch("Uint16Array", d)),
+        }
+    } else if let Some(a) = values.dyn_ref::<Uint8Array>() {
+        match dtype {
+            None | Some(Dtype::U8) => Ok(grid::samples_from_u8(&a.to_vec())),
+            Some(d) => grid::samples_from_bytes(&a.to_vec(), d, grid).map_err(js_error),
+        }
+    } else if let Some(b) = values.dyn_ref::<ArrayBuffer>() {
+        let d = dtype.ok_or_else(|| {
+            js_error(Error::InvalidOption("an ArrayBuffer of samples needs a dtype option".into()))
+        })?;
+        grid::samples_from_bytes(&Uint8Array::new(b).to_vec(), d, grid).map_err(js_error)
+    } else if js_sys::Array::is_array(values) {
+        match dtype {
+            None | Some(Dtype::F32) => Ok(Float32Array::new(values).to_vec()),
+            Some(d) => Err(mismatch("plain Array", d)),
+        }
+    } else {
+        Err(js_error(Error::InvalidGrid(
+            "values must be a Float32Array, Uint8Array, Uint16Array, an array of numbers, or an ArrayBuffer with a dtype"
+                .into(),
+        )))
+    }
+}
+
+/// Meshes a sampled volume. `values` holds `dims[0] * dims[1] * dims[2]` samples, x fastest, at the
+/// points of a lattice spanning `bounds` = [x0, y0, z0, x1, y1, z1] (`dims` counts points, not
+/// cells). Integer samples keep their values (give `iso` in 0..255 for bytes); `options.dtype`
+/// reinterprets raw little-endian bytes.
+#[wasm_bindgen(js_name = meshGrid, unchecked_return_type = "MeshResult")]
+pub fn mesh_grid(
+    #[wasm_bindgen(
+        unchecked_param_type = "Float32Array | Uint8Array | Uint16Array | number[] | ArrayBuffer"
+    )]
+    values: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "[number, number, number] | Uint32Array")] dims: Vec<u32>,
+    #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
+    bounds: Vec<f32>,
+    #[wasm_bindgen(unchecked_param_type = "GridOptions | undefined")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let (request, dtype, _) = parse_grid_options(options)?;
     if dims.len() != 3 || dims.iter().any(|&d| d < 2) {
         return Err(js_error(Error::InvalidGrid(format!(
             "dims must be three point counts, each at least 2, got {dims:?}"
@@ -199,6 +459,60 @@ pub fn mesh_grid(
     let cells = [dims[0] as usize - 1, dims[1] as usize - 1, dims[2] as usize - 1];
     let grid = Grid::new(min, max, cells).map_err(js_error)?;
     grid.check_size(request.max_cells).map_err(js_error)?;
-    let (mesh, stats) = pipeline::mesh_samples(values, &grid, &request).map_err(js_error)?;
-    to_js(&mesh, &stats)
+    let samples = grid_samples(&values, dtype, &grid)?;
+    to_js(&pipeline::mesh_samples(&samples, &grid, &request).map_err(js_error)?)
+}
+
+/// The message of whatever a JavaScript function threw.
+fn thrown_message(e: &JsValue) -> String {
+    if let Some(err) = e.dyn_ref::<js_sys::Error>() {
+        return String::from(err.message());
+    }
+    if let Some(s) = e.as_string() {
+        return s;
+    }
+    js_sys::JSON::stringify(e).ok().and_then(|s| s.as_string()).unwrap_or_else(|| format!("{e:?}"))
+}
+
+/// Meshes a field given as a JavaScript function, the slow path for shapes the language cannot
+/// express. `fn(points)` gets a Float32Array of xyz triples (one z-slab of the grid per call) and
+/// returns a Float32Array (or array) with one value per point, negative inside. The grid spans
+/// `bounds` = [x0, y0, z0, x1, y1, z1] with `options.res` cells along its longest side; gradients
+/// are central differences of the samples. Throws an `Error` if `fn` throws, returns the wrong
+/// number of values or a non-finite one.
+#[wasm_bindgen(js_name = meshFunction, unchecked_return_type = "MeshResult")]
+pub fn mesh_function(
+    #[wasm_bindgen(unchecked_param_type = "BatchFieldFunction")] f: js_sys::Function,
+    #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
+    bounds: Vec<f32>,
+    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let request = parse_options(options)?;
+    let bounds = parse_bounds(&bounds)?;
+    let batch = BatchFn::new(
+        |points: &[Vec3], out: &mut [f32]| {
+            let flat: Vec<f32> = points.iter().flat_map(|p| p.to_array()).collect();
+            let arg = Float32Array::from(&flat[..]);
+            let result =
+                f.call1(&JsValue::NULL, &arg).map_err(|e| format!("it threw: {}", thrown_message(&e)))?;
+            let values = if let Some(a) = result.dyn_ref::<Float32Array>() {
+                a.to_vec()
+            } else if js_sys::Array::is_array(&result) {
+                Float32Array::new(&result).to_vec()
+            } else {
+                return Err("it must return a Float32Array or an array of numbers".into());
+            };
+            if values.len() != out.len() {
+                return Err(format!(
+                    "it returned {} values for {} points (one value per xyz triple)",
+                    values.len(),
+                    out.len()
+                ));
+            }
+            out.copy_from_slice(&values);
+            Ok(())
+        },
+        1e-3,
+    );
+    to_js(&pipeline::mesh_function(&batch, bounds, &request).map_err(js_error)?)
 }

@@ -161,3 +161,20 @@ fn the_crust_traversal_gives_the_uniform_grid_result_from_far_fewer_evaluations(
         assert!(crust.points_evaluated * 3 < grid.point_count(), "{text}: {}", crust.points_evaluated);
     }
 }
+
+#[test]
+fn every_scene_keeps_mc_topology_without_self_intersections() {
+    for name in isoforge::scenes::SCENE_NAMES {
+        let scene = isoforge::scenes::scene(name).unwrap();
+        for res in [24, 40] {
+            let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+            let (mc_mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+            let (emc, _) = emc::mesh_field(scene.field.as_ref(), &grid, &EmcOptions::default()).unwrap();
+            let what = format!("{name} at {res}");
+            let mc_topo = analysis::topology(&mc_mesh);
+            let emc_topo = assert_watertight(&emc.mesh, &what);
+            assert_eq!(emc_topo.euler, mc_topo.euler, "{what}");
+            assert_eq!(emc_topo.components, mc_topo.components, "{what}");
+        }
+    }
+}

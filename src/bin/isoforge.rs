@@ -1,12 +1,15 @@
-//! `isoforge`: mesh a scene from the command line, write OBJ/STL/PLY, print stats as JSON.
+//! `isoforge`: mesh a built-in scene, a program in the expression language or a raw volume from
+//! the command line, write OBJ/STL/PLY, print stats as JSON.
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
+use isoforge::field::SampleGradient;
+use isoforge::grid::{self, Dtype, Grid};
 use isoforge::mc::Topology;
 use isoforge::mesh::export;
-use isoforge::pipeline::{self, Method, Request};
+use isoforge::pipeline::{self, Method, Output, Request};
 use isoforge::stats::AnalysisOptions;
-use isoforge::{scenes, Error, Vec3};
-use std::path::PathBuf;
+use isoforge::{expr, scenes, Error, Vec3};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -18,26 +21,55 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Mesh a scene and optionally write the mesh and print its stats.
-    Mesh(MeshArgs),
-    /// List the built-in scenes.
-    Scenes,
+    /// Mesh a scene, an expression or a raw volume; optionally write the mesh and print its stats.
+    Mesh(Box<MeshArgs>),
+    /// List the built-in scenes, or print one scene's program.
+    Scenes {
+        /// Print this scene's program in the expression language.
+        name: Option<String>,
+    },
 }
 
+/// The inputs other than --grid, which the volume's layout options make no sense with. (A plain
+/// `requires = "grid"` is not enforced by clap for a member of the input group.)
+const NOT_GRID: [&str; 3] = ["scene", "expr", "expr_file"];
+
 #[derive(clap::Args)]
+#[command(group(ArgGroup::new("input").required(true).args(["scene", "expr", "expr_file", "grid"])))]
 struct MeshArgs {
-    /// A built-in scene (see `isoforge scenes`).
+    /// A built-in scene (see `isoforge scenes`), meshed in its own bounds.
     #[arg(long)]
-    scene: String,
+    scene: Option<String>,
+    /// A program in the expression language, meshed in --bounds (default [-1, 1]³).
+    #[arg(long, allow_hyphen_values = true, value_name = "TEXT")]
+    expr: Option<String>,
+    /// A file holding a program in the expression language (like --expr).
+    #[arg(long, value_name = "FILE")]
+    expr_file: Option<PathBuf>,
+    /// A raw volume: samples without a header, little-endian, x fastest (needs --dims).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["bounds", "res"])]
+    grid: Option<PathBuf>,
+    /// Sample points per axis of the --grid volume.
+    #[arg(long, value_parser = list::<usize, 3>, value_name = "X,Y,Z", conflicts_with_all = NOT_GRID)]
+    dims: Option<[usize; 3]>,
+    /// Sample type of the --grid volume [default: f32].
+    #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
+    dtype: Option<DtypeArg>,
+    /// Distance between --grid samples per axis [default: 1,1,1].
+    #[arg(long, value_parser = list::<f32, 3>, value_name = "SX,SY,SZ", conflicts_with_all = NOT_GRID)]
+    spacing: Option<[f32; 3]>,
+    /// Position of the first --grid sample [default: 0,0,0].
+    #[arg(long, value_parser = list::<f32, 3>, value_name = "X,Y,Z", allow_hyphen_values = true, conflicts_with_all = NOT_GRID)]
+    origin: Option<[f32; 3]>,
     /// Meshing method: mc (Marching Cubes) or emc (Extended Marching Cubes).
     #[arg(long, default_value = "mc")]
     method: String,
-    /// Cells along the longest side of the bounds.
+    /// Cells along the longest side of the bounds (a --grid has its own).
     #[arg(long, default_value_t = 64)]
     res: usize,
-    /// x0,y0,z0,x1,y1,z1: mesh this box instead of the scene's own.
-    #[arg(long, value_delimiter = ',', num_args = 6, allow_hyphen_values = true)]
-    bounds: Option<Vec<f32>>,
+    /// Mesh this box instead of the scene's own ([-1, 1]³ for expressions).
+    #[arg(long, value_parser = list::<f32, 6>, value_name = "X0,Y0,Z0,X1,Y1,Z1", allow_hyphen_values = true)]
+    bounds: Option<[f32; 6]>,
     /// Iso-level: points with value < iso are inside.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     iso: f32,
@@ -65,6 +97,16 @@ struct MeshArgs {
     /// EMC: place edge crossings by linear interpolation instead of exact root finding.
     #[arg(long)]
     no_directed: bool,
+    /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
+    /// central differences at the samples interpolated (continuous across cells) [default: central].
+    #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
+    gradient: Option<GradientArg>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GradientArg {
+    Trilinear,
+    Central,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -73,16 +115,24 @@ enum TopologyArg {
     Trilinear,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum DtypeArg {
+    F32,
+    U8,
+    U16,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Scenes => {
+        Command::Scenes { name: None } => {
             for name in scenes::SCENE_NAMES {
                 println!("{name}");
             }
             Ok(())
         }
-        Command::Mesh(args) => mesh(args),
+        Command::Scenes { name: Some(name) } => scenes::source(&name).map(|text| print!("{text}")),
+        Command::Mesh(args) => mesh(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -103,14 +153,17 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
             TopologyArg::Trilinear => Topology::Trilinear,
         },
         max_cells: args.max_cells,
-        bounds: args.bounds.map(|b| (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]))),
+        bounds: args.bounds.as_ref().map(|b| (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]))),
         analysis: AnalysisOptions { self_intersections: !args.no_intersections, surface_error: true },
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
+        gradient: match args.gradient {
+            Some(GradientArg::Trilinear) => SampleGradient::Trilinear,
+            Some(GradientArg::Central) | None => SampleGradient::CentralDifferences,
+        },
     };
-    let scene = scenes::scene(&args.scene)?;
-    let out = pipeline::mesh_field(scene.field.as_ref(), (scene.min, scene.max), &request)?;
+    let out = mesh_input(&args, &request)?;
     if let Some(path) = &args.output {
         export::write_by_extension(&out.mesh, path)?;
     }
@@ -118,4 +171,54 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Io(e.to_string()))?);
     }
     Ok(())
+}
+
+/// Meshes whichever input was given (clap makes sure it is exactly one).
+fn mesh_input(args: &MeshArgs, request: &Request) -> Result<Output, Error> {
+    if let Some(name) = &args.scene {
+        pipeline::mesh_scene(name, request)
+    } else if let Some(text) = &args.expr {
+        pipeline::mesh_expr(text, request)
+    } else if let Some(path) = &args.expr_file {
+        let text = std::fs::read_to_string(path).map_err(|e| io_error(path, e))?;
+        // Compiler style: file:line:column: message.
+        let program = expr::compile(&text).map_err(|e| match e {
+            Error::Parse { .. } => Error::Io(format!("{}:{e}", path.display())),
+            e => e,
+        })?;
+        pipeline::mesh_program(&program, request)
+    } else if let Some(path) = &args.grid {
+        let dims = args.dims.ok_or_else(|| Error::InvalidOption("--grid needs --dims X,Y,Z".into()))?;
+        let origin = args.origin.map_or(Vec3::ZERO, Vec3::from);
+        let spacing = args.spacing.map_or(Vec3::ONE, Vec3::from);
+        let grid = Grid::from_points(dims, origin, spacing)?;
+        grid.check_size(request.max_cells)?;
+        let dtype = match args.dtype.unwrap_or(DtypeArg::F32) {
+            DtypeArg::F32 => Dtype::F32,
+            DtypeArg::U8 => Dtype::U8,
+            DtypeArg::U16 => Dtype::U16,
+        };
+        let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+        let values = grid::samples_from_bytes(&bytes, dtype, &grid)?;
+        pipeline::mesh_samples(&values, &grid, request)
+    } else {
+        Err(Error::InvalidOption("give one of --scene, --expr, --expr-file, --grid".into()))
+    }
+}
+
+/// `N` comma-separated numbers, e.g. `--dims 64,64,32` or `--bounds -1,-1,-1,1,1,1`.
+fn list<T: std::str::FromStr, const N: usize>(text: &str) -> Result<[T; N], String>
+where
+    T::Err: std::fmt::Display,
+{
+    let values = text
+        .split(',')
+        .map(|t| t.trim().parse::<T>().map_err(|e| format!("'{}': {e}", t.trim())))
+        .collect::<Result<Vec<T>, String>>()?;
+    let n = values.len();
+    values.try_into().map_err(|_| format!("expected {N} comma-separated numbers, got {n}"))
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> Error {
+    Error::Io(format!("cannot read {}: {e}", path.display()))
 }

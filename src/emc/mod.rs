@@ -21,6 +21,7 @@ use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{joined_faces, ms_since, polygon_center, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
 use crate::tables::{
     polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
@@ -28,7 +29,7 @@ use crate::tables::{
 };
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, feature_point, FeatureKind};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use web_time::Instant;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -233,9 +234,11 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                 let mut first_triangle = 0;
                 let cell_min = grid.position(i, j, k);
                 let cell_max = cell_min + grid.spacing;
+                // Pass 1: the polygons' vertices, and for each a feature point where it is sharp.
+                let mut plans: Vec<Plan> = Vec::with_capacity(4);
                 for (p, poly) in polygons.iter().enumerate() {
                     let count = triangles.per_polygon[p] as usize;
-                    let group = &triangles.edges[3 * first_triangle..3 * (first_triangle + count)];
+                    let group = first_triangle..first_triangle + count;
                     first_triangle += count;
                     let mut by_edge = [NONE; 13];
                     for &e in poly {
@@ -252,16 +255,19 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                     let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
-                    let mut f = Vec3::ZERO;
+                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        // One bad solve must not throw a spike: the point stays inside its cell or
-                        // within half a cell of it. Candidates, best first: an edge point slid
-                        // along its feature line (the planes fix it only up to that line) into the
-                        // cell, or into the cell grown by half a cell (a corner point as solved, if
-                        // it lies there); then the point clamped into the cell, or into the grown
-                        // cell. The first with a valid fan is taken.
+                        // One bad solve must not throw a spike: the point stays inside its cell
+                        // (strictly, so no fan triangle lies in a cell face) or within half a cell
+                        // of it. Candidates, best first: an edge point slid along its feature line
+                        // (the planes fix it only up to that line) into the cell, or into the cell
+                        // grown by half a cell (a corner point as solved, if it lies there); then
+                        // the point clamped into the cell, or into the grown cell. The first with
+                        // a valid fan is taken; where none works, the component stays plain MC.
                         let solved = feature_point(&pts, &nrm, kind);
+                        let inset = grid.spacing * 1e-2;
+                        let (inner_min, inner_max) = (cell_min + inset, cell_max - inset);
                         let margin = grid.spacing * 0.5;
                         let (grown_min, grown_max) = (cell_min - margin, cell_max + margin);
                         let line = if kind == FeatureKind::Edge { edge_direction(&nrm) } else { None };
@@ -270,26 +276,42 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                             None => (solved.cmpge(lo).all() && solved.cmple(hi).all()).then_some(solved),
                         };
                         let candidates = [
-                            on_feature(cell_min, cell_max),
+                            on_feature(inner_min, inner_max),
                             on_feature(grown_min, grown_max),
-                            Some(solved.clamp(cell_min, cell_max)),
+                            Some(solved.clamp(inner_min, inner_max)),
                             Some(solved.clamp(grown_min, grown_max)),
                         ];
-                        f = solved.clamp(cell_min, cell_max);
-                        if let Some(c) = candidates.into_iter().flatten().find(|&c| fan_is_valid(c, &pts, &nrm)) {
-                            f = c;
+                        match candidates.into_iter().flatten().find(|&c| fan_is_valid(c, &pts, &nrm)) {
+                            Some(f) => feature = Some((f, kind)),
+                            None => out.rejected_features += 1,
                         }
-                        // Where none works, the component stays plain MC.
-                        if !fan_is_valid(f, &pts, &nrm) {
-                            kind = FeatureKind::Smooth;
+                    }
+                    plans.push(Plan { by_edge, ids, pts, nrm, group, feature });
+                }
+                // Pass 2: where a cell holds several components (sheets close together), a fan
+                // that would cut another component's triangles falls back to MC.
+                for a in 0..plans.len() {
+                    if plans.len() > 1 && plans[a].feature.is_some() {
+                        let fan = plans[a].triangles(&out.mesh.positions, triangles);
+                        let cuts = (0..plans.len()).filter(|&b| b != a).any(|b| {
+                            let other = plans[b].triangles(&out.mesh.positions, triangles);
+                            fan.iter().any(|t| other.iter().any(|u| triangles_intersect(t, u)))
+                        });
+                        if cuts {
+                            plans[a].feature = None;
                             out.rejected_features += 1;
                         }
                     }
-                    if kind == FeatureKind::Smooth {
+                }
+                // Pass 3: emit.
+                for plan in plans {
+                    let Some((f, kind)) = plan.feature else {
+                        let mut by_edge = plan.by_edge;
+                        let group = &triangles.edges[3 * plan.group.start..3 * plan.group.end];
                         if group.contains(&CENTER) {
                             by_edge[CENTER as usize] = out.mesh.positions.len() as u32;
                             out.mesh.positions.push(polygon_center(&out.mesh.positions, group, &by_edge));
-                            normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                            normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
                         }
                         for t in group.chunks_exact(3) {
@@ -300,15 +322,16 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                             ]);
                         }
                         continue;
-                    }
+                    };
                     let fid = out.mesh.positions.len() as u32;
                     out.mesh.positions.push(f);
-                    normals_of_vertex.push(nrm.iter().sum::<Vec3>().normalize_or_zero());
+                    normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                     out.feature_vertex.push(true);
                     match kind {
                         FeatureKind::Corner => out.corner_features += 1,
                         _ => out.edge_features += 1,
                     }
+                    let ids = &plan.ids;
                     for q in 0..ids.len() {
                         out.mesh.triangles.push([fid, ids[q], ids[(q + 1) % ids.len()]]);
                     }
@@ -318,6 +341,46 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
     }
     out.mesh.normals = normals_of_vertex;
     out
+}
+
+/// What one component of a cell will become: its polygon and, where sharp, its feature point.
+struct Plan {
+    by_edge: [u32; 13],
+    /// The polygon's vertex ids and positions, in order.
+    ids: Vec<u32>,
+    pts: Vec<Vec3>,
+    nrm: Vec<Vec3>,
+    /// Its triangles in the cell's MC triangulation (triangle indices).
+    group: std::ops::Range<usize>,
+    feature: Option<(Vec3, FeatureKind)>,
+}
+
+impl Plan {
+    /// The triangles this component would emit, as positions (fan or MC triangulation).
+    fn triangles(&self, positions: &[Vec3], table: &CellTriangles) -> Vec<[DVec3; 3]> {
+        let n = self.pts.len();
+        match self.feature {
+            Some((f, _)) => {
+                (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
+            }
+            None => {
+                let group = &table.edges[3 * self.group.start..3 * self.group.end];
+                let center = self.pts.iter().sum::<Vec3>() / n as f32;
+                group
+                    .chunks_exact(3)
+                    .map(|t| {
+                        [t[0], t[1], t[2]].map(|e| {
+                            if e == CENTER {
+                                center.as_dvec3()
+                            } else {
+                                positions[self.by_edge[e as usize] as usize].as_dvec3()
+                            }
+                        })
+                    })
+                    .collect()
+            }
+        }
+    }
 }
 
 /// Direction of the feature line of an edge cell: across the two most different normals.

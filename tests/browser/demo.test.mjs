@@ -87,3 +87,34 @@ test('a bad request shows a clear error instead of freezing the tab', async () =
   assert.match(message, /larger than the limit/);
   await page.close();
 });
+
+test('the editor shows the scene program, and an edited program is meshed instead', async () => {
+  const { page, errors } = await openDemo();
+  assert.match(await page.inputValue('#source'), /subtract\(box\(0\.6, 0\.6, 0\.6\), sphere\(0\.75\)\)/);
+  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
+  await page.selectOption('#scene', 'rocket');
+  await page.waitForSelector('#status[data-state="done"]');
+  assert.match(await page.inputValue('#source'), /rotate\(fin, 0, 0, 1, 82\)/);
+  await page.fill('#source', '// a ring\ntorus(0.5, 0.2)');
+  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
+  await page.click('#run');
+  await page.waitForSelector('#status[data-state="done"]');
+  assert.equal(await stat(page, 'Euler characteristic'), '0');
+  await page.fill('#source', 'union(sphere(0.5),\n  bx(1, 1, 1))');
+  await page.click('#run');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.match(await page.textContent('#status'), /^2:3: unknown function 'bx'/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('EMC draws feature lines', async () => {
+  const { page } = await openDemo();
+  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
+  await page.selectOption('#method', 'emc');
+  await page.click('#run');
+  await page.waitForSelector('#status[data-state="done"]');
+  assert.ok(Number((await stat(page, 'feature edges')).replace(/,/g, '')) > 0);
+  assert.equal(await stat(page, 'closed manifold'), 'yes');
+  await page.close();
+});

@@ -1,0 +1,194 @@
+// The JavaScript API as a page uses it: the built package loaded in headless Chromium (Debian's),
+// every export called with real typed arrays, objects and strings. Run by scripts/test.sh after
+// the wasm package is built.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { chromium } from 'playwright-core';
+
+const PORT = 9000 + Math.floor(Math.random() * 1000);
+const URL = `http://127.0.0.1:${PORT}/`;
+let server;
+let browser;
+let page;
+
+before(async () => {
+  server = spawn(process.execPath, ['scripts/serve.mjs', 'www', String(PORT)], { stdio: ['ignore', 'pipe', 'inherit'] });
+  await new Promise((resolve, reject) => {
+    server.stdout.once('data', resolve);
+    server.once('exit', (code) => reject(new Error(`server exited with ${code}`)));
+  });
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+  page = await browser.newPage();
+  // Any page of the origin will do; the package is imported by each test's script.
+  await page.goto(`${URL}style.css`);
+  await page.evaluate(async () => {
+    const m = await import('./pkg/isoforge.js');
+    await m.default();
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  server?.kill();
+});
+
+/** Runs `body(m)` in the page with the initialised module `m`; returns what it returns (JSON-able). */
+const inPage = (body, arg) => page.evaluate(async ([src, arg]) => {
+  const m = await import('./pkg/isoforge.js');
+  // eslint-disable-next-line no-new-func
+  return new Function('m', 'arg', `return (${src})(m, arg);`)(m, arg);
+}, [body.toString(), arg]);
+
+test('compile returns a reusable shape that meshes at several resolutions', async () => {
+  const r = await inPage((m) => {
+    const s = m.compile('r = 0.5; sphere(r)');
+    const coarse = m.meshShape(s, { res: 12 });
+    const fine = m.meshShape(s, { res: 24 });
+    const out = {
+      value: s.value(0, 0, 0), grad: Array.from(s.valueAndGradient(1, 0, 0)), instructions: s.instructionCount,
+      coarse: coarse.stats.triangles, fine: fine.stats.triangles, euler: fine.stats.euler,
+      types: [fine.positions, fine.normals, fine.indices, fine.featureEdges].map((a) => a.constructor.name),
+      features: fine.featureEdges.length,
+    };
+    s.free();
+    return out;
+  });
+  assert.equal(r.value, -0.5);
+  assert.deepEqual(r.grad, [0.5, 1, 0, 0]);
+  assert.ok(r.instructions > 0);
+  assert.ok(r.fine > r.coarse && r.coarse > 0);
+  assert.equal(r.euler, 2);
+  assert.deepEqual(r.types, ['Float32Array', 'Float32Array', 'Uint32Array', 'Uint32Array']);
+  assert.equal(r.features, 0, 'Marching Cubes finds no feature lines');
+});
+
+test('parse errors throw an Error with line, column and caret', async () => {
+  const r = await inPage((m) => {
+    const messages = [];
+    for (const f of [() => m.compile('union(sphere(1),\n  bx(1, 1, 1))'), () => m.meshExpr('sphere(0.5) +')]) {
+      try { f(); messages.push(null); } catch (e) { messages.push({ isError: e instanceof Error, message: e.message }); }
+    }
+    return messages;
+  });
+  assert.equal(r[0].isError, true);
+  assert.equal(r[0].message, "2:3: unknown function 'bx'; did you mean 'box'?\n  bx(1, 1, 1))\n  ^");
+  assert.match(r[1].message, /^1:\d+: /);
+});
+
+test('meshExpr and meshCsg mesh in [-1, 1]³ or the given bounds', async () => {
+  const r = await inPage((m) => {
+    const tree = { op: 'subtract', args: [{ op: 'box', half: [0.6, 0.6, 0.6] }, { op: 'sphere', radius: 0.75 }] };
+    let csgError = null;
+    try { m.meshCsg({ op: 'sphere', radius: 1, radiuss: 2 }); } catch (e) { csgError = e.message; }
+    return {
+      expr: m.meshExpr('subtract(box(0.6, 0.6, 0.6), sphere(0.75))', { res: 24 }).stats.euler,
+      big: m.meshExpr('sphere(2)', { res: 16, bounds: [-2.5, -2.5, -2.5, 2.5, 2.5, 2.5] }).stats.euler,
+      clipped: m.meshExpr('sphere(2)', { res: 16 }).stats.triangles,
+      object: m.meshCsg(tree, { res: 24 }).stats.euler,
+      string: m.meshCsg(JSON.stringify(tree), { res: 24 }).stats.triangles,
+      shape: m.meshShape(m.compileCsg(tree), { res: 24 }).stats.triangles,
+      csgError,
+    };
+  });
+  assert.equal(r.expr, -8);
+  assert.equal(r.big, 2);
+  assert.equal(r.clipped, 0, 'a ball around the default bounds [-1, 1]³ has no surface in them');
+  assert.equal(r.object, -8);
+  assert.equal(r.string, r.shape);
+  assert.match(r.csgError, /unknown field `radiuss`/);
+});
+
+test('scenes come with their source text, which meshes the same', async () => {
+  const r = await inPage((m) => {
+    const names = m.sceneNames();
+    const src = m.sceneSource('torus');
+    let unknown = null;
+    try { m.sceneSource('tours'); } catch (e) { unknown = e.message; }
+    return {
+      names, src, unknown,
+      scene: m.meshScene('gyroid', { res: 20 }).stats.triangles,
+      text: m.meshExpr(m.sceneSource('gyroid'), { res: 20, bounds: m.sceneBounds('gyroid') }).stats.triangles,
+      bounds: m.sceneBounds('fandisk'),
+    };
+  });
+  for (const n of ['sphere', 'torus', 'gyroid', 'cube_minus_sphere', 'two_spheres_touching', 'rotated_box',
+    'fandisk', 'thin_room', 'rocket', 'milling', 'cube_with_cutouts']) assert.ok(r.names.includes(n), n);
+  assert.match(r.src, /torus\(0\.6, 0\.25\)/);
+  assert.match(r.unknown, /unknown scene 'tours'/);
+  assert.equal(r.scene, r.text);
+  assert.deepEqual(r.bounds.map((v) => Math.round(v * 100) / 100), [-0.9, -0.6, -0.55, 0.9, 0.6, 0.55]);
+});
+
+test('meshGrid takes Float32Array, Uint8Array, Uint16Array and raw bytes with a dtype', async () => {
+  const r = await inPage((m) => {
+    // 21³ samples over [-1, 1]³ of 200 |p|: iso 120 is the sphere of radius 0.6.
+    const n = 21;
+    const f = new Float32Array(n * n * n);
+    for (let k = 0, i = 0; k < n; k++) for (let j = 0; j < n; j++) for (let x = 0; x < n; x++, i++) {
+      const p = [x, j, k].map((c) => -1 + 0.1 * c);
+      f[i] = Math.min(255, 200 * Math.hypot(...p));
+    }
+    const u8 = Uint8Array.from(f, Math.round);
+    const u16 = Uint16Array.from(f, (v) => Math.round(v * 100));
+    const bytes = new Uint8Array(u16.buffer.slice(0));
+    const dims = [n, n, n];
+    const bounds = [-1, -1, -1, 1, 1, 1];
+    const run = (values, options) => {
+      try {
+        const s = m.meshGrid(values, dims, bounds, options).stats;
+        return { euler: s.euler, volume: s.volume, closed: s.closed_manifold };
+      } catch (e) { return { error: e.message }; }
+    };
+    return {
+      f32: run(f, { iso: 120 }),
+      u8: run(u8, { iso: 120 }),
+      u16: run(u16, { iso: 12000 }),
+      rawU16: run(bytes, { iso: 12000, dtype: 'u16' }),
+      buffer: run(u16.buffer, { iso: 12000, dtype: 'u16' }),
+      array: run(Array.from(f), { iso: 120 }),
+      mismatch: run(f, { iso: 120, dtype: 'u8' }),
+      noDtype: run(u16.buffer, { iso: 12000 }),
+      shortBytes: run(bytes.subarray(1), { iso: 12000, dtype: 'u16' }),
+      elsewhere: (() => { try { m.meshScene('sphere', { dtype: 'u8' }); } catch (e) { return e.message; } })(),
+    };
+  });
+  const expected = 4 / 3 * Math.PI * 0.6 ** 3;
+  for (const k of ['f32', 'u8', 'u16', 'rawU16', 'buffer', 'array']) {
+    assert.equal(r[k].closed, true, `${k}: ${JSON.stringify(r[k])}`);
+    assert.equal(r[k].euler, 2, k);
+    assert.ok(Math.abs(r[k].volume - expected) < 0.05 * expected, `${k}: volume ${r[k].volume}`);
+  }
+  assert.match(r.mismatch.error, /dtype "u8" does not match a Float32Array/);
+  assert.match(r.noDtype.error, /needs a dtype/);
+  assert.match(r.shortBytes.error, /take 18522 bytes, got 18521/);
+  assert.match(r.elsewhere, /dtype is an option of meshGrid only/);
+});
+
+test('EMC options are passed through and feature edges come back', async () => {
+  const r = await inPage((m) => {
+    const emc = m.meshScene('rotated_box', { method: 'emc', res: 24, thetaSharp: 0.9, phiCorner: 0.7, directed: true });
+    const errors = [];
+    for (const o of [{ method: 'emc', thetaSharp: 2 }, { method: 'dmc' }, { thetaSharpe: 0.5 }]) {
+      try { m.meshScene('sphere', { res: 8, ...o }); errors.push(null); } catch (e) { errors.push(e.message); }
+    }
+    const f = emc.featureEdges;
+    return {
+      method: emc.stats.method, closed: emc.stats.closed_manifold, euler: emc.stats.euler,
+      pairs: f.length / 2, even: f.length % 2 === 0, counted: emc.stats.feature_edges,
+      inRange: f.every((i) => i < emc.positions.length / 3), errors,
+    };
+  });
+  assert.equal(r.method, 'emc');
+  assert.equal(r.closed, true);
+  assert.equal(r.euler, 2);
+  assert.ok(r.pairs > 0 && r.even && r.inRange);
+  assert.equal(r.pairs, r.counted);
+  assert.match(r.errors[0], /thetaSharp/);
+  assert.match(r.errors[1], /unknown method 'dmc'/);
+  assert.match(r.errors[2], /unknown field `thetaSharpe`, expected one of .*`thetaSharp`/);
+});

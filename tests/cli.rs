@@ -1,0 +1,211 @@
+//! The command-line tool, run as a real process: each input kind, the stats JSON, errors, outputs.
+#![cfg(not(target_arch = "wasm32"))]
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn isoforge(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_isoforge")).args(args).output().expect("run isoforge")
+}
+
+/// Runs a command that must succeed and returns its stdout.
+fn ok(args: &[&str]) -> String {
+    let out = isoforge(args);
+    assert!(out.status.success(), "isoforge {args:?} failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Runs a command that must fail and returns its stderr.
+fn fails(args: &[&str]) -> String {
+    let out = isoforge(args);
+    assert!(!out.status.success(), "isoforge {args:?} should have failed");
+    assert!(out.stdout.is_empty(), "nothing on stdout when failing");
+    String::from_utf8(out.stderr).unwrap()
+}
+
+fn stats(args: &[&str]) -> Value {
+    let mut all = args.to_vec();
+    all.push("--stats");
+    serde_json::from_str(&ok(&all)).expect("--stats prints one JSON object")
+}
+
+/// A path in cargo's per-target scratch directory, unique per test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn scene_stats_have_every_key() {
+    let s = stats(&["mesh", "--scene", "torus", "--res", "24"]);
+    for key in [
+        "method",
+        "res",
+        "vertices",
+        "triangles",
+        "closed_manifold",
+        "euler",
+        "genus",
+        "components",
+        "min_angle_deg",
+        "max_angle_deg",
+        "dist_max",
+        "dist_rms",
+        "normal_dev_deg_p50",
+        "normal_dev_deg_p95",
+        "ms_total",
+    ] {
+        assert!(s.get(key).is_some_and(|v| !v.is_null()), "missing or null '{key}' in {s}");
+    }
+    assert_eq!(s["method"], "mc");
+    assert_eq!(s["res"], 24);
+    assert_eq!(s["closed_manifold"], true);
+    assert_eq!(s["euler"], 0);
+    assert_eq!(s["genus"], 1);
+}
+
+#[test]
+fn scenes_are_listed_and_their_programs_printed() {
+    let names = ok(&["scenes"]);
+    for name in isoforge::scenes::SCENE_NAMES {
+        assert!(names.lines().any(|l| l == name), "{name} not listed");
+    }
+    assert_eq!(ok(&["scenes", "rocket"]), isoforge::scenes::source("rocket").unwrap());
+    assert!(fails(&["scenes", "rockett"]).contains("unknown scene 'rockett'"));
+}
+
+#[test]
+fn an_expression_is_meshed_in_the_default_or_given_bounds() {
+    let s = stats(&["mesh", "--expr", "sphere(0.7)", "--res", "20"]);
+    assert_eq!(s["euler"], 2);
+    assert!(s["dist_max"].as_f64().unwrap() < 0.02, "{s}");
+    // Default bounds are [-1, 1]³: a radius-1.5 ball only fits in larger ones.
+    let s = stats(&["mesh", "--expr", "r = 1.5; sphere(r)", "--res", "20", "--bounds", "-2,-2,-2,2,2,2"]);
+    assert_eq!(s["euler"], 2);
+    assert!((s["volume"].as_f64().unwrap() - 4.0 / 3.0 * std::f64::consts::PI * 3.375).abs() < 0.3, "{s}");
+    // A leading minus is the expression's, not an option.
+    let s = stats(&["mesh", "--expr", "-(0.5 - length(x, y, z))", "--res", "12"]);
+    assert_eq!(s["euler"], 2);
+}
+
+#[test]
+fn an_expression_file_is_meshed_and_its_errors_name_the_file() {
+    let path = scratch("frame.isf");
+    std::fs::write(&path, "// a frame\nsubtract(box(0.6, 0.6, 0.6), sphere(0.75))\n").unwrap();
+    let s = stats(&["mesh", "--expr-file", path.to_str().unwrap(), "--res", "24"]);
+    assert_eq!(s["euler"], -8);
+    std::fs::write(&path, "a = sphere(0.5);\nunion(a, bx(1, 1, 1))\n").unwrap();
+    let err = fails(&["mesh", "--expr-file", path.to_str().unwrap()]);
+    assert!(err.contains(&format!("{}:2:10: unknown function 'bx'", path.display())), "{err}");
+    let err = fails(&["mesh", "--expr-file", scratch("missing.isf").to_str().unwrap()]);
+    assert!(err.contains("cannot read"), "{err}");
+}
+
+#[test]
+fn a_malformed_expression_fails_with_line_column_and_caret() {
+    let err = fails(&["mesh", "--expr", "union(sphere(0.5),\n      box(1, 2)"]);
+    // Exactly where: line 2, and a caret under the column on the quoted line.
+    let at = err.find("2:").expect("line:column");
+    assert!(err[at..].starts_with("2:7: "), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines[1], "      box(1, 2)", "{err}");
+    assert_eq!(lines[2], "      ^", "{err}");
+    let err = fails(&["mesh", "--expr", "sphere(0.5) +"]);
+    assert!(err.contains("1:"), "{err}");
+}
+
+#[test]
+fn exactly_one_input_is_required() {
+    let err = fails(&["mesh", "--scene", "sphere", "--expr", "sphere(1)"]);
+    assert!(err.contains("cannot be used with"), "{err}");
+    assert!(fails(&["mesh", "--res", "8"]).contains("required"));
+    assert!(fails(&["mesh", "--grid", "x.raw"]).contains("--dims"));
+    assert!(fails(&["mesh", "--scene", "sphere", "--dims", "2,2,2"]).contains("cannot be used with"));
+    assert!(fails(&["mesh", "--grid", "x.raw", "--dims", "2,2"]).contains("expected 3"));
+}
+
+/// A dark ball (low values) of radius 0.6 in brighter surroundings, sampled on 21³ points over
+/// [-1, 1]³: `value = 200 |p|`, so iso 120 is the sphere of radius 0.6.
+fn ball_volume() -> Vec<f32> {
+    let mut out = Vec::new();
+    for k in 0..21 {
+        for j in 0..21 {
+            for i in 0..21 {
+                let p = [i, j, k].map(|c| -1.0 + 0.1 * c as f32);
+                out.push((200.0 * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt()).min(255.0));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn raw_volumes_of_each_sample_type_are_meshed() {
+    let values = ball_volume();
+    let u8s: Vec<u8> = values.iter().map(|&v| v.round() as u8).collect();
+    let u16s: Vec<u8> = values.iter().flat_map(|&v| ((v * 100.0).round() as u16).to_le_bytes()).collect();
+    let f32s: Vec<u8> = values.iter().flat_map(|&v| v.to_le_bytes()).collect();
+    let expected = 4.0 / 3.0 * std::f64::consts::PI * 0.6f64.powi(3);
+    for (dtype, bytes, iso) in [("u8", u8s, "120"), ("u16", u16s, "12000"), ("f32", f32s, "120")] {
+        let path = scratch(&format!("ball_{dtype}.raw"));
+        std::fs::write(&path, &bytes).unwrap();
+        let path = path.to_str().unwrap();
+        let args = [
+            "mesh", "--grid", path, "--dims", "21,21,21", "--dtype", dtype, "--iso", iso, "--origin",
+            "-1,-1,-1",
+        ];
+        let s = stats(&[&args[..], &["--spacing", "0.1,0.1,0.1"]].concat());
+        assert_eq!(s["closed_manifold"], true, "{dtype}: {s}");
+        assert_eq!(s["euler"], 2, "{dtype}");
+        assert_eq!(s["res"], 20, "{dtype}: a grid's resolution is its cells on the longest side");
+        let volume = s["volume"].as_f64().unwrap();
+        assert!((volume - expected).abs() < 0.05 * expected, "{dtype}: volume {volume} vs {expected}");
+    }
+    // Without --origin and --spacing the samples sit at integer positions from 0.
+    let path = scratch("ball_u8.raw");
+    let s = stats(&[
+        "mesh",
+        "--grid",
+        path.to_str().unwrap(),
+        "--dims",
+        "21,21,21",
+        "--dtype",
+        "u8",
+        "--iso",
+        "120",
+    ]);
+    let volume = s["volume"].as_f64().unwrap();
+    assert!((volume - expected * 1000.0).abs() < 0.05 * expected * 1000.0, "{volume}");
+    // The byte count must match the dimensions and type.
+    let err = fails(&["mesh", "--grid", path.to_str().unwrap(), "--dims", "21,21,21", "--dtype", "u16"]);
+    assert!(err.contains("21 x 21 x 21 u16 samples take 18522 bytes, got 9261"), "{err}");
+    assert!(fails(&["mesh", "--grid", path.to_str().unwrap(), "--dims", "21,21,21", "--res", "8"])
+        .contains("cannot be used with"));
+}
+
+#[test]
+fn output_files_follow_their_extension() {
+    let mut sizes = Vec::new();
+    for ext in ["obj", "stl", "ply"] {
+        let path = scratch(&format!("torus.{ext}"));
+        let _ = std::fs::remove_file(&path);
+        let s = stats(&["mesh", "--scene", "torus", "--res", "16", "-o", path.to_str().unwrap()]);
+        let bytes = std::fs::read(&path).expect("the mesh file was written");
+        let triangles = s["triangles"].as_u64().unwrap() as usize;
+        match ext {
+            "obj" => {
+                let text = String::from_utf8(bytes.clone()).unwrap();
+                assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), triangles);
+            }
+            "stl" => assert_eq!(bytes.len(), 84 + 50 * triangles),
+            _ => assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n")),
+        }
+        sizes.push(bytes.len());
+    }
+    assert!(sizes.iter().all(|&n| n > 1000), "{sizes:?}");
+    let err =
+        fails(&["mesh", "--scene", "torus", "--res", "8", "-o", scratch("torus.xyz").to_str().unwrap()]);
+    assert!(!err.is_empty());
+}
