@@ -81,7 +81,8 @@ impl MeshBvh {
                 t.swap(1, 2);
             }
         }
-        let normals = triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
+        let normals =
+            triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bvh = Bvh::build(&boxes);
         Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, flipped })
@@ -236,7 +237,8 @@ fn axis_hit(tri: &[Vec3; 3], axis: usize, q: Vec3) -> Option<(f64, i32)> {
         w[k] = e;
     }
     let sum = w[0] + w[1] + w[2];
-    let coordinate = (w[0] * tri[0][axis] as f64 + w[1] * tri[1][axis] as f64 + w[2] * tri[2][axis] as f64) / sum;
+    let coordinate =
+        (w[0] * tri[0][axis] as f64 + w[1] * tri[1][axis] as f64 + w[2] * tri[2][axis] as f64) / sum;
     Some((coordinate, if ccw { 1 } else { -1 }))
 }
 
@@ -362,7 +364,10 @@ impl EdgeSampler for MeshRays<'_> {
         }
         let t = da / (da - db);
         let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 };
-        let n = self.mesh.nearest(a + (b - a) * t, f32::INFINITY).map_or(Vec3::ZERO, |(_, tri)| self.mesh.normal(tri));
+        let n = self
+            .mesh
+            .nearest(a + (b - a) * t, f32::INFINITY)
+            .map_or(Vec3::ZERO, |(_, tri)| self.mesh.normal(tri));
         (t, n)
     }
 }
@@ -416,7 +421,9 @@ pub fn padded_grid(min: Vec3, max: Vec3, res: usize) -> Result<Grid, Error> {
     }
     let longest = (max - min).max_element();
     if longest <= 0.0 {
-        return Err(Error::InvalidGrid(format!("the input is a single point ({min}); it has no extent to mesh")));
+        return Err(Error::InvalidGrid(format!(
+            "the input is a single point ({min}); it has no extent to mesh"
+        )));
     }
     let h = longest / (res - 4) as f32;
     Grid::with_resolution(min - Vec3::splat(2.0 * h), max + Vec3::splat(2.0 * h), res)
@@ -428,7 +435,10 @@ mod tests {
     use crate::mesh::analysis::fixtures::{cube, mc_sphere, octahedron};
 
     fn brute_nearest(m: &MeshBvh, p: Vec3) -> f32 {
-        m.triangles.iter().map(|t| (closest_point_on_triangle(p, t) - p).length()).fold(f32::INFINITY, f32::min)
+        m.triangles
+            .iter()
+            .map(|t| (closest_point_on_triangle(p, t) - p).length())
+            .fold(f32::INFINITY, f32::min)
     }
 
     #[test]
@@ -500,7 +510,11 @@ mod tests {
         let (_, tri) = bvh.nearest(Vec3::new(2.0, 2.0, 2.0), f32::INFINITY).unwrap();
         assert!(bvh.normal(tri).dot(Vec3::ONE) > 0.0);
         let grid = Grid::new(Vec3::splat(-1.5), Vec3::splat(1.5), [2, 2, 2]).unwrap();
-        assert_eq!(bvh.inside_votes(&grid)[grid.index(1, 1, 1)], 3, "the centre, on lines through the vertices");
+        assert_eq!(
+            bvh.inside_votes(&grid)[grid.index(1, 1, 1)],
+            3,
+            "the centre, on lines through the vertices"
+        );
     }
 
     #[test]
@@ -508,7 +522,11 @@ mod tests {
         let mut m = cube();
         m.triangles.push([0, 1, 8]);
         assert!(matches!(MeshBvh::new(&m), Err(Error::InvalidOption(msg)) if msg.contains("triangle 12")));
-        let flat = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0], normals: vec![], triangles: vec![[0, 1, 2]] };
+        let flat = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+            normals: vec![],
+            triangles: vec![[0, 1, 2]],
+        };
         assert!(MeshBvh::new(&flat).is_err());
         assert!(padded_grid(Vec3::ZERO, Vec3::ONE, 4).is_err());
         assert!(padded_grid(Vec3::ONE, Vec3::ONE, 16).is_err());

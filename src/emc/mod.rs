@@ -260,11 +260,14 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                     if kind != FeatureKind::Smooth {
                         // One bad solve must not throw a spike: the point stays inside its cell
                         // (strictly, so no fan triangle lies in a cell face) or within half a cell
-                        // of it. Candidates, best first: an edge point slid along its feature line
-                        // (the planes fix it only up to that line) into the cell, or into the cell
-                        // grown by half a cell (a corner point as solved, if it lies there); then
-                        // the point clamped into the cell, or into the grown cell. The first with
-                        // a valid fan is taken; where none works, the component stays plain MC.
+                        // of it. Candidates, best first: the point slid along its feature line
+                        // into the cell (an edge's planes fix it only up to that line, so this
+                        // keeps it on the edge where clamping would pull it off; a corner must
+                        // already lie in the cell); then the point clamped into the cell, or into
+                        // the cell grown by half a cell. Sliding along the line out of the cell
+                        // (before or after clamping) made fans cut their neighbours' on the gyroid
+                        // at 24. The first with a valid fan is taken; where none works, the
+                        // component stays plain MC.
                         let solved = feature_point(&pts, &nrm, kind);
                         let inset = grid.spacing * 1e-2;
                         let (inner_min, inner_max) = (cell_min + inset, cell_max - inset);
@@ -277,7 +280,6 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                         };
                         let candidates = [
                             on_feature(inner_min, inner_max),
-                            on_feature(grown_min, grown_max),
                             Some(solved.clamp(inner_min, inner_max)),
                             Some(solved.clamp(grown_min, grown_max)),
                         ];

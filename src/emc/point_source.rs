@@ -103,7 +103,8 @@ impl PointIndex {
             }
             let axis = self.axes[mid] as usize;
             let offset = p[axis] - self.positions[mid][axis];
-            let (near, far) = if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
+            let (near, far) =
+                if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
             // The far side lies beyond the splitting plane.
             let mut far_gap = gap;
             far_gap[axis] = far_gap[axis].max(offset.abs());
@@ -146,7 +147,8 @@ impl PointIndex {
             offer(out, mid);
             let axis = self.axes[mid] as usize;
             let offset = p[axis] - self.positions[mid][axis];
-            let (near, far) = if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
+            let (near, far) =
+                if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
             let mut far_gap = gap;
             far_gap[axis] = far_gap[axis].max(offset.abs());
             stack.push((far.0, far.1, far_gap));
@@ -180,7 +182,9 @@ fn build(positions: &[Vec3], order: &mut [u32], axes: &mut [u8], offset: usize) 
         2
     };
     let mid = order.len() / 2;
-    order.select_nth_unstable_by(mid, |&a, &b| positions[a as usize][axis].total_cmp(&positions[b as usize][axis]));
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        positions[a as usize][axis].total_cmp(&positions[b as usize][axis])
+    });
     axes[offset + mid] = axis as u8;
     let (left, right) = order.split_at_mut(mid);
     build(positions, left, axes, offset);
@@ -221,7 +225,9 @@ pub fn grid_values(points: &PointIndex, grid: &Grid) -> Vec<f32> {
                 let distance = (points.sample(q).0 - p).length();
                 if value.abs() < BESIDE * distance {
                     points.k_nearest(p, NEIGHBOURS, &mut neighbours);
-                    let facing = |&(d2, s): &(f32, u32)| points.plane_distance(s, p).abs() / d2.sqrt().max(f32::MIN_POSITIVE);
+                    let facing = |&(d2, s): &(f32, u32)| {
+                        points.plane_distance(s, p).abs() / d2.sqrt().max(f32::MIN_POSITIVE)
+                    };
                     if let Some(best) = neighbours.iter().max_by(|a, b| facing(a).total_cmp(&facing(b))) {
                         value = points.plane_distance(best.1, p);
                     }
@@ -298,7 +304,7 @@ impl EdgeSampler for TangentPlanes<'_> {
 /// EMC surface reconstruction from an oriented point cloud on `grid` (paper §5.2). The cloud
 /// should cover the surface densely compared with the grid's cells, and its normals must point
 /// out of the solid; `options.crust` does not apply and `options.iso` offsets the tangent-plane
-/// distances (0 reconstructs the sampled surface itself).
+/// distances would not be distances to the surface, so it must be 0.
 pub fn reconstruct(
     points: &PointCloud,
     grid: &Grid,
@@ -348,7 +354,8 @@ mod tests {
             for (k, &p) in cloud(50).positions.iter().enumerate() {
                 let p = p * 1.5;
                 let found = index.sample(index.nearest(p, Some(k as u32))).0;
-                let brute = c.positions.iter().map(|q| (*q - p).length_squared()).fold(f32::INFINITY, f32::min);
+                let brute =
+                    c.positions.iter().map(|q| (*q - p).length_squared()).fold(f32::INFINITY, f32::min);
                 assert_eq!((found - p).length_squared(), brute, "n = {n}, p = {p}");
                 // Approximate beyond 0.1: never more than half the excess over 0.1 too far.
                 let approx = (index.sample(index.nearest_approx(p, None, 0.1)).0 - p).length();

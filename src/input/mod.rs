@@ -47,7 +47,9 @@ impl PointCloud {
 
     /// Smallest box holding every point; `(+inf, -inf)` when there are none.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+        self.positions
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
     }
 
     /// Checks the cloud can be meshed: as many normals as points, all finite, normals of unit length
@@ -82,7 +84,9 @@ impl PointCloud {
         for (i, n) in self.normals.iter_mut().enumerate() {
             let unit = n.normalize_or_zero();
             if unit == Vec3::ZERO || !unit.is_finite() {
-                return Err(Error::InvalidOption(format!("point {i} has normal {n}, which has no direction")));
+                return Err(Error::InvalidOption(format!(
+                    "point {i} has normal {n}, which has no direction"
+                )));
             }
             *n = unit;
         }
@@ -115,7 +119,10 @@ pub fn read_mesh(bytes: &[u8], format_hint: Option<&str>) -> Result<Mesh, Error>
         _ => unreachable!("format_name only returns listed names"),
     };
     if mesh.triangles.is_empty() {
-        return Err(Error::Io(format!("{} file has no faces (of non-zero area) to mesh", format.to_uppercase())));
+        return Err(Error::Io(format!(
+            "{} file has no faces (of non-zero area) to mesh",
+            format.to_uppercase()
+        )));
     }
     Ok(mesh)
 }
@@ -240,7 +247,10 @@ mod tests {
         assert_eq!(format_name(".stl", &MESH_FORMATS, "mesh").unwrap(), "stl");
         assert_eq!(format_name("dir.v2/part.Ply", &MESH_FORMATS, "mesh").unwrap(), "ply");
         let err = format_name("gltf", &MESH_FORMATS, "mesh").unwrap_err();
-        assert!(matches!(&err, Error::InvalidOption(m) if m.contains("'gltf'") && m.contains("off")), "{err}");
+        assert!(
+            matches!(&err, Error::InvalidOption(m) if m.contains("'gltf'") && m.contains("off")),
+            "{err}"
+        );
     }
 
     #[test]

@@ -22,9 +22,9 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, Error> {
             Some("v") => {
                 let mut c = [0.0f32; 3];
                 for (a, slot) in c.iter_mut().enumerate() {
-                    let token = tokens.next().ok_or_else(|| {
-                        fail(format!("vertex has {a} coordinates; 'v' needs x y z"))
-                    })?;
+                    let token = tokens
+                        .next()
+                        .ok_or_else(|| fail(format!("vertex has {a} coordinates; 'v' needs x y z")))?;
                     *slot = parse_f32(token).map_err(&fail)?;
                 }
                 positions.push(Vec3::from(c));

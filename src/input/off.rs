@@ -45,19 +45,23 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, Error> {
     }
     let count = |k: usize, what: &str| -> Result<usize, Error> {
         let token = rest.get(k).ok_or_else(|| fail(counts_line, format!("missing the {what} count")))?;
-        token.parse().map_err(|_| fail(counts_line, format!("{what} count '{}' is not a count", shorten(token))))
+        token
+            .parse()
+            .map_err(|_| fail(counts_line, format!("{what} count '{}' is not a count", shorten(token))))
     };
     let (vertices, faces) = (count(0, "vertex")?, count(1, "face")?);
 
     let mut positions = Vec::with_capacity(vertices.min(bytes.len() / 6));
     for v in 0..vertices {
-        let (n, line) = lines.next().ok_or_else(|| {
-            Error::Io(format!("OFF file ends after {v} of its {vertices} vertices"))
-        })?;
+        let (n, line) = lines
+            .next()
+            .ok_or_else(|| Error::Io(format!("OFF file ends after {v} of its {vertices} vertices")))?;
         let mut c = [0.0f32; 3];
         let mut tokens = line.split_whitespace();
         for (a, slot) in c.iter_mut().enumerate() {
-            let token = tokens.next().ok_or_else(|| fail(n, format!("vertex has {a} coordinates; it needs x y z")))?;
+            let token = tokens
+                .next()
+                .ok_or_else(|| fail(n, format!("vertex has {a} coordinates; it needs x y z")))?;
             *slot = parse_f32(token).map_err(|e| fail(n, e))?;
         }
         positions.push(Vec3::from(c));
@@ -70,18 +74,24 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, Error> {
             lines.next().ok_or_else(|| Error::Io(format!("OFF file ends after {f} of its {faces} faces")))?;
         let mut tokens = line.split_whitespace();
         let size = tokens.next().unwrap_or("");
-        let size: usize =
-            size.parse().map_err(|_| fail(n, format!("expected the face's vertex count, found '{}'", shorten(size))))?;
+        let size: usize = size
+            .parse()
+            .map_err(|_| fail(n, format!("expected the face's vertex count, found '{}'", shorten(size))))?;
         if size < 3 {
             return Err(fail(n, format!("face has {size} vertices; faces need at least 3")));
         }
         polygon.clear();
         for k in 0..size {
-            let token = tokens.next().ok_or_else(|| fail(n, format!("face lists {k} of its {size} vertices")))?;
-            let index: u32 =
-                token.parse().map_err(|_| fail(n, format!("expected a vertex index, found '{}'", shorten(token))))?;
+            let token =
+                tokens.next().ok_or_else(|| fail(n, format!("face lists {k} of its {size} vertices")))?;
+            let index: u32 = token
+                .parse()
+                .map_err(|_| fail(n, format!("expected a vertex index, found '{}'", shorten(token))))?;
             if index as usize >= positions.len() {
-                return Err(fail(n, format!("vertex index {index} is past the {} vertices", positions.len())));
+                return Err(fail(
+                    n,
+                    format!("vertex index {index} is past the {} vertices", positions.len()),
+                ));
             }
             polygon.push(index);
         }

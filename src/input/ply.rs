@@ -109,7 +109,8 @@ impl PlyData {
     pub(super) fn into_points(self) -> Result<PointCloud, Error> {
         let Some(normals) = self.normals else {
             return Err(Error::Io(
-                "PLY vertices have no normals (properties nx ny nz); a point cloud needs oriented points".into(),
+                "PLY vertices have no normals (properties nx ny nz); a point cloud needs oriented points"
+                    .into(),
             ));
         };
         PointCloud { positions: self.positions, normals }
@@ -127,7 +128,12 @@ pub(super) fn read(bytes: &[u8]) -> Result<PlyData, Error> {
             text = String::from_utf8_lossy(body);
             Source::Ascii { lines: text.lines(), tokens: "".split_whitespace(), line: header_lines }
         }
-        _ => Source::Binary { bytes: body, pos: 0, offset: body_start, big: encoding == Encoding::BinaryBigEndian },
+        _ => Source::Binary {
+            bytes: body,
+            pos: 0,
+            offset: body_start,
+            big: encoding == Encoding::BinaryBigEndian,
+        },
     };
     let mut data = PlyData::default();
     let mut vertex_count = None;
@@ -175,7 +181,10 @@ pub(super) fn read(bytes: &[u8]) -> Result<PlyData, Error> {
                             let v = source.value(item_ty).map_err(|e| Error::Io(at(&e, &source)))?;
                             if is_faces {
                                 if v < 0.0 || v.fract() != 0.0 || v > u32::MAX as f64 {
-                                    return Err(Error::Io(at(&format!("vertex index {v} is invalid"), &source)));
+                                    return Err(Error::Io(at(
+                                        &format!("vertex index {v} is invalid"),
+                                        &source,
+                                    )));
                                 }
                                 let index = v as u32;
                                 if largest_index.is_none_or(|(m, _)| m < index as u64) {
@@ -186,7 +195,8 @@ pub(super) fn read(bytes: &[u8]) -> Result<PlyData, Error> {
                         }
                         if is_faces {
                             if polygon.len() < 3 {
-                                let msg = format!("face has {} vertices; faces need at least 3", polygon.len());
+                                let msg =
+                                    format!("face has {} vertices; faces need at least 3", polygon.len());
                                 return Err(Error::Io(at(&msg, &source)));
                             }
                             push_fan(&polygon, &mut data.triangles);
@@ -244,10 +254,9 @@ fn vertex_slots(element: &Element) -> Result<[Option<usize>; 6], Error> {
 }
 
 fn face_list(element: &Element) -> Option<usize> {
-    element
-        .properties
-        .iter()
-        .position(|p| matches!(p.kind, Kind::List(..)) && (p.name == "vertex_indices" || p.name == "vertex_index"))
+    element.properties.iter().position(|p| {
+        matches!(p.kind, Kind::List(..)) && (p.name == "vertex_indices" || p.name == "vertex_index")
+    })
 }
 
 /// Where the values come from: whitespace-separated text, or packed bytes.
@@ -321,19 +330,25 @@ fn header(bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize, usize), Error>
             }
             ["comment", ..] | ["obj_info", ..] | [] => {}
             ["element", name, count] => {
-                let count =
-                    count.parse().map_err(|_| fail(format!("element count '{}' is not a count", shorten(count))))?;
+                let count = count
+                    .parse()
+                    .map_err(|_| fail(format!("element count '{}' is not a count", shorten(count))))?;
                 elements.push(Element { name: name.to_string(), count, properties: Vec::new() });
             }
             ["property", rest @ ..] => {
-                let element = elements.last_mut().ok_or_else(|| fail("property before any element".into()))?;
+                let element =
+                    elements.last_mut().ok_or_else(|| fail("property before any element".into()))?;
                 let scalar = |name: &str| {
                     Scalar::parse(name).ok_or_else(|| fail(format!("unknown type '{}'", shorten(name))))
                 };
                 let (kind, name) = match rest {
                     ["list", count, item, name] => (Kind::List(scalar(count)?, scalar(item)?), name),
                     [ty, name] => (Kind::Scalar(scalar(ty)?), name),
-                    _ => return Err(fail("expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'".into())),
+                    _ => {
+                        return Err(fail(
+                            "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'".into(),
+                        ))
+                    }
                 };
                 element.properties.push(Property { name: name.to_string(), kind });
             }
@@ -399,9 +414,11 @@ mod tests {
         assert!(err.to_string().contains("lacks"), "{err}");
         let err = read(SQUARE.replace("format ascii", "format utf8").as_bytes()).unwrap_err().to_string();
         assert!(err.contains("header line 2"), "{err}");
-        let err = read(b"ply\nformat ascii 1.0\nelement vertex 1000000000000\n\
-            property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n")
-            .unwrap_err();
+        let err = read(
+            b"ply\nformat ascii 1.0\nelement vertex 1000000000000\n\
+            property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n",
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("file ends"), "{err}");
     }
 

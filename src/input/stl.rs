@@ -45,9 +45,12 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh, Error> {
     let mut welder = Welder::default();
     let mut triangles = Vec::with_capacity(count as usize);
     for (t, record) in bytes[84..needed as usize].chunks_exact(50).enumerate() {
-        let float = |k: usize| f32::from_le_bytes([record[4 * k], record[4 * k + 1], record[4 * k + 2], record[4 * k + 3]]);
+        let float = |k: usize| {
+            f32::from_le_bytes([record[4 * k], record[4 * k + 1], record[4 * k + 2], record[4 * k + 3]])
+        };
         // Floats 0..3 are the facet normal; 3..12 the corners.
-        let corners: [Vec3; 3] = std::array::from_fn(|c| Vec3::new(float(3 + 3 * c), float(4 + 3 * c), float(5 + 3 * c)));
+        let corners: [Vec3; 3] =
+            std::array::from_fn(|c| Vec3::new(float(3 + 3 * c), float(4 + 3 * c), float(5 + 3 * c)));
         if let Some(bad) = corners.iter().find(|p| !p.is_finite()) {
             return Err(Error::Io(format!(
                 "binary STL triangle {t} (byte {}) has corner {bad}; coordinates must be finite",

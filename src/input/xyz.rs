@@ -11,7 +11,8 @@ pub(super) fn read(bytes: &[u8]) -> Result<PointCloud, Error> {
     for (n, line) in text.lines().enumerate() {
         let fail = |msg: String| Error::Io(format!("XYZ line {}: {msg}", n + 1));
         let line = super::strip_comment(line, '#').trim_start_matches('\u{feff}');
-        let tokens: Vec<&str> = line.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()).collect();
+        let tokens: Vec<&str> =
+            line.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()).collect();
         if tokens.is_empty() {
             continue;
         }

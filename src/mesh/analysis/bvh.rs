@@ -181,7 +181,8 @@ impl Bvh {
                 continue;
             }
             let (l, r) = (id + 1, node.first_or_right);
-            let (kl, kr) = (key(state, &self.nodes[l as usize].bounds), key(state, &self.nodes[r as usize].bounds));
+            let (kl, kr) =
+                (key(state, &self.nodes[l as usize].bounds), key(state, &self.nodes[r as usize].bounds));
             // Pushed last, popped first: the nearer child.
             match (kl, kr) {
                 (Some(a), Some(b)) if a <= b => stack.extend([r, l]),
