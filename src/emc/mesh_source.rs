@@ -153,6 +153,12 @@ impl MeshBvh {
         (best.1 != u32::MAX).then(|| (best.0.sqrt(), best.1))
     }
 
+    /// The point of the mesh nearest to `p` and the triangle it lies on.
+    pub fn closest_point(&self, p: Vec3) -> Option<(Vec3, u32)> {
+        let (_, t) = self.nearest(p, f32::INFINITY)?;
+        Some((closest_point_on_triangle(p, &self.triangles[t as usize]), t))
+    }
+
     /// Per grid point, how many of the three axis lines through it find it inside (non-zero
     /// winding number, counting the signed crossings between the line's start and the point).
     pub fn inside_votes(&self, grid: &Grid) -> Vec<u8> {
