@@ -484,15 +484,15 @@ mod tests {
         let m = MeshBvh::new(&cube()).unwrap();
         let grid = Grid::new(Vec3::splat(-0.5), Vec3::splat(1.5), [4, 4, 4]).unwrap();
         let votes = m.inside_votes(&grid);
-        for n in 0..grid.point_count() {
+        for (n, &vote) in votes.iter().enumerate() {
             let [i, j, k] = grid.unindex(n);
             let p = grid.position(i, j, k);
             let strictly_inside = p.cmpgt(Vec3::ZERO).all() && p.cmplt(Vec3::ONE).all();
             let outside = p.cmplt(Vec3::ZERO).any() || p.cmpgt(Vec3::ONE).any();
             if strictly_inside {
-                assert_eq!(votes[n], 3, "{p}");
+                assert_eq!(vote, 3, "{p}");
             } else if outside {
-                assert_eq!(votes[n], 0, "{p}");
+                assert_eq!(vote, 0, "{p}");
             }
         }
         // A segment along a face diagonal's projection hits exactly one of the two triangles.
