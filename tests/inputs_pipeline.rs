@@ -213,6 +213,7 @@ mod wasm_api {
     use super::*;
     use isoforge::wasm::{mesh_points, mesh_triangles};
     use wasm_bindgen::{JsCast, JsValue};
+    use wasm_bindgen_test::wasm_bindgen_test as test;
 
     fn options(method: &str) -> JsValue {
         let o = js_sys::Object::new();
