@@ -10,6 +10,8 @@
 //! - [`emc`]: Extended Marching Cubes (sharp features on the MC grid).
 //! - [`dmc`]: Dual Marching Cubes (an octree adapted to the field, contoured on its dual grid).
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
+//! - [`input`]: reading triangle meshes (OBJ, STL, PLY, OFF) and oriented point clouds (PLY, XYZ)
+//!   for EMC's remeshing and surface reconstruction ([`emc::mesh_source`], [`emc::point_source`]).
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
 //!
@@ -21,6 +23,7 @@ pub mod error;
 pub mod expr;
 pub mod field;
 pub mod grid;
+pub mod input;
 pub mod mc;
 pub mod mesh;
 pub mod pipeline;

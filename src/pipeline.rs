@@ -1,5 +1,7 @@
 //! From a request (method, resolution, options) to a mesh and its stats: the one path the CLI, the
 //! wasm bindings and the benches share, so the three can never disagree about what a request means.
+//! Fields (scenes, programs, functions) and sampled volumes are meshed here; triangle meshes and
+//! point clouds in [`inputs`].
 
 use crate::dmc::{self, DmcOptions, DmcStats};
 use crate::emc::{self, EmcMesh, EmcOptions};
@@ -12,6 +14,9 @@ use crate::mesh::Mesh;
 use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
+
+mod inputs;
+pub use inputs::{mesh_points, mesh_triangles, MeshDistance, PlaneDistance};
 
 /// The meshing methods. Names are the CLI's `--method` and the wasm API's `method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -16,6 +16,9 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
+mod inputs;
+pub use inputs::{mesh_points, mesh_triangles};
+
 #[wasm_bindgen(start)]
 fn start() {
     console_error_panic_hook::set_once();
@@ -46,8 +49,10 @@ export interface MeshOptions {
   /** Refuse grids with more cells than this (default 72 000 000). */
   maxCells?: number;
   /**
-   * [x0, y0, z0, x1, y1, z1]: mesh this box instead of the input's own bounds (a scene's, or
-   * [-1, 1]³ for shapes, expressions and CSG trees). Ignored by meshGrid.
+   * [x0, y0, z0, x1, y1, z1]: mesh this box instead of the input's own bounds (a scene's,
+   * [-1, 1]³ for shapes, expressions and CSG trees, and for meshTriangles / meshPoints the
+   * input's bounding box padded by two cells, `res` cells along its longest side). Ignored by
+   * meshGrid.
    */
   bounds?: [number, number, number, number, number, number];
   /** Run the pairwise self-intersection check (default false: it is the costliest check). */
@@ -121,6 +126,18 @@ export interface MeshStats {
   /** DMC: leaves of the final octree and dual cells traversed (null for other methods). */
   octree_leaves: number | null; dual_cells: number | null;
 }
+
+/**
+ * Inputs that are not fields (EMC's remeshing and reconstruction applications), as typed arrays:
+ * - meshTriangles(positions: Float32Array, indices: Uint32Array, options?: MeshOptions): remesh a
+ *   closed triangle mesh (xyz triples; vertex-index triples, counter-clockwise from outside);
+ * - meshPoints(positions: Float32Array, normals: Float32Array, options?: MeshOptions): reconstruct
+ *   the surface sampled by points with outward normals (xyz triples each).
+ * Use method "emc" for sharp edges and corners; "mc" (default) is plain Marching Cubes on the same
+ * grid. iso must be 0. Stats measure against the input (distance to the mesh, or to the nearest
+ * sample's tangent plane).
+ */
+export type InputFunctions = "meshTriangles" | "meshPoints";
 
 /** A mesh ready for WebGL / three.js: `positions` and `normals` are xyz triples, `indices` triangles (CCW = outward). */
 export interface MeshResult {

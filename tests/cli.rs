@@ -228,3 +228,82 @@ fn dmc_reports_its_octree_and_phases() {
     let err = fails(&["mesh", "--scene", "torus", "--method", "dmc", "--samples-per-cell", "1"]);
     assert!(err.contains("samplesPerCell"), "{err}");
 }
+
+#[test]
+fn triangle_meshes_of_every_format_are_remeshed() {
+    for ext in ["obj", "stl", "ply"] {
+        let input = scratch(&format!("box_in.{ext}"));
+        ok(&[
+            "mesh",
+            "--scene",
+            "rotated_box",
+            "--method",
+            "emc",
+            "--res",
+            "16",
+            "-o",
+            input.to_str().unwrap(),
+        ]);
+        let s = stats(&["mesh", "--mesh", input.to_str().unwrap(), "--method", "emc", "--res", "24"]);
+        assert_eq!(s["closed_manifold"], true, "{ext}");
+        assert_eq!(s["euler"], 2, "{ext}");
+        assert_eq!(s["res"], 24, "{ext}: --res cells along the input's longest side");
+        assert_eq!(s["self_intersections"], 0, "{ext}");
+        // The box's eight corners, and a few more where the coarse input's own fans are corners.
+        assert!(s["corner_features"].as_u64().unwrap() >= 8, "{ext}: {}", s["corner_features"]);
+        assert!(s["dist_max"].as_f64().unwrap() < 0.05, "{ext}: {}", s["dist_max"]);
+    }
+    let off = scratch("tetra.off");
+    std::fs::write(&off, "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+        .unwrap();
+    let s = stats(&["mesh", "--mesh", off.to_str().unwrap(), "--method", "emc", "--res", "20"]);
+    assert_eq!((s["closed_manifold"].clone(), s["euler"].clone()), (true.into(), 2.into()));
+    assert!(s["corner_features"].as_u64().unwrap() >= 4, "{}", s["corner_features"]);
+}
+
+#[test]
+fn point_clouds_are_reconstructed() {
+    let path = scratch("sphere.xyz");
+    let mut text = String::from("# x y z nx ny nz\n");
+    let n = 4000;
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let (rho, a) = ((1.0 - z * z).sqrt(), i as f32 * 2.399_963);
+        let (x, y) = (rho * a.cos(), rho * a.sin());
+        text += &format!("{} {} {} {x} {y} {z}\n", 0.6 * x, 0.6 * y, 0.6 * z);
+    }
+    std::fs::write(&path, text).unwrap();
+    let s = stats(&["mesh", "--points", path.to_str().unwrap(), "--method", "emc", "--res", "20"]);
+    assert_eq!((s["closed_manifold"].clone(), s["euler"].clone()), (true.into(), 2.into()));
+    // The grid covers the input's bounds padded by two cells: a box wider than that would make
+    // the cells (and so the triangles) larger.
+    let wide =
+        stats(&["mesh", "--points", path.to_str().unwrap(), "--res", "20", "--bounds", "-2,-2,-2,2,2,2"]);
+    assert!(wide["triangles"].as_u64().unwrap() * 3 < s["triangles"].as_u64().unwrap(), "{wide} vs {s}");
+}
+
+#[test]
+fn dmc_remeshes_a_triangle_mesh_into_a_closed_surface_near_it() {
+    let input = scratch("box_for_dmc.obj");
+    ok(&["mesh", "--scene", "rotated_box", "--method", "emc", "--res", "16", "-o", input.to_str().unwrap()]);
+    let s = stats(&["mesh", "--mesh", input.to_str().unwrap(), "--method", "dmc", "--res", "24"]);
+    assert_eq!((s["closed_manifold"].clone(), s["euler"].clone()), (true.into(), 2.into()), "{s}");
+    assert!(s["dist_max"].as_f64().unwrap() < 0.05, "{}", s["dist_max"]);
+    assert!(s["octree_leaves"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn malformed_mesh_and_point_files_name_the_file_and_line() {
+    let bad = scratch("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n").unwrap();
+    let err = fails(&["mesh", "--mesh", bad.to_str().unwrap()]);
+    assert!(err.contains("bad.obj") && err.contains("line 4"), "{err}");
+    let bad = scratch("bad.xyz");
+    std::fs::write(&bad, "0 0 0 0 0 1\n1 2 3\n").unwrap();
+    let err = fails(&["mesh", "--points", bad.to_str().unwrap()]);
+    assert!(err.contains("bad.xyz") && err.contains("line 2"), "{err}");
+    let err = fails(&["mesh", "--mesh", scratch("missing.stl").to_str().unwrap()]);
+    assert!(err.contains("missing.stl"), "{err}");
+    let err = fails(&["mesh", "--mesh", bad.to_str().unwrap(), "--scene", "sphere"]);
+    assert!(err.contains("cannot be used with"), "{err}");
+}

@@ -68,15 +68,20 @@ fn cube_minus_sphere_is_sharper_and_closer_than_mc() {
     let field = expr::compile(CUBE_MINUS_SPHERE).unwrap();
     for res in [32, 64] {
         let c = compare(&field, res);
-        let what = format!("res {res}");
+        let what = format!("cube_minus_sphere res {res}");
         let tris = c.emc.mesh.triangle_count() as f64 / c.mc_triangles as f64;
         assert!(tris < 1.35, "{what}: {tris:.2}x MC's triangles");
         let p95 = c.mc_error.normal_dev_deg_p95 / c.emc_error.normal_dev_deg_p95;
         let dist = c.mc_error.dist_max / c.emc_error.dist_max;
+        eprintln!(
+            "{what}: triangles {tris:.3}x MC's, normal p95 {:.3}° vs MC {:.2}° ({p95:.1}x), distance max {:.2e} vs {:.2e} ({dist:.2}x)",
+            c.emc_error.normal_dev_deg_p95, c.mc_error.normal_dev_deg_p95, c.emc_error.dist_max, c.mc_error.dist_max
+        );
+        // Measured: 4.0x and 31.8x (p95), 2.00x and 2.70x (max distance) at res 32 and 64.
         assert!(p95 > 3.5, "{what}: normal deviation p95 only {p95:.2}x better");
         assert!(dist > 1.8, "{what}: max distance only {dist:.2}x better");
         if res == 64 {
-            assert!(p95 > 20.0, "{what}: normal deviation p95 only {p95:.2}x better");
+            assert!(p95 > 25.0, "{what}: normal deviation p95 only {p95:.2}x better");
             assert!(dist > 2.5, "{what}: max distance only {dist:.2}x better");
         }
         // Eight cube corners are found as corners.
@@ -105,12 +110,18 @@ fn rotated_box_is_sharper_and_its_edges_become_feature_lines() {
     let field = expr::compile(ROTATED_BOX).unwrap();
     for res in [32, 64] {
         let c = compare(&field, res);
-        let what = format!("res {res}");
+        let what = format!("rotated box res {res}");
         let tris = c.emc.mesh.triangle_count() as f64 / c.mc_triangles as f64;
         assert!(tris < 1.2, "{what}: {tris:.2}x MC's triangles");
         let p95 = c.mc_error.normal_dev_deg_p95 / c.emc_error.normal_dev_deg_p95;
         let dist = c.mc_error.dist_max / c.emc_error.dist_max;
-        assert!(p95 > 2.5, "{what}: normal deviation p95 only {p95:.2}x better");
+        eprintln!(
+            "{what}: triangles {tris:.3}x MC's, normal p95 {:.3}° vs MC {:.2}° ({p95:.1}x), distance max {:.2e} vs {:.2e} ({dist:.2}x)",
+            c.emc_error.normal_dev_deg_p95, c.mc_error.normal_dev_deg_p95, c.emc_error.dist_max, c.mc_error.dist_max
+        );
+        // Measured: 4.0x and 5.1x (p95), 1.97x and 1.53x (max distance) at res 32 and 64.
+        let p95_floor = if res == 32 { 3.5 } else { 4.5 };
+        assert!(p95 > p95_floor, "{what}: normal deviation p95 only {p95:.2}x better");
         assert!(dist > 1.4, "{what}: max distance only {dist:.2}x better");
         assert_eq!(c.emc.corner_features, 8, "{what}: the box's eight corners");
         // Feature lines cover most of the box's 12 edges (4 × (1 + .7 + .5) = 8.8 long). Not all:

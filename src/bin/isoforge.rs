@@ -1,5 +1,5 @@
-//! `isoforge`: mesh a built-in scene, a program in the expression language or a raw volume from
-//! the command line, write OBJ/STL/PLY, print stats as JSON.
+//! `isoforge`: mesh a built-in scene, a program in the expression language, a raw volume, a
+//! triangle mesh or an oriented point cloud from the command line, write OBJ/STL/PLY, print stats as JSON.
 
 use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
 use isoforge::field::SampleGradient;
@@ -8,7 +8,7 @@ use isoforge::mc::Topology;
 use isoforge::mesh::export;
 use isoforge::pipeline::{self, Method, Output, Request};
 use isoforge::stats::AnalysisOptions;
-use isoforge::{expr, scenes, Error, Vec3};
+use isoforge::{expr, input, scenes, Error, Vec3};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -21,7 +21,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Mesh a scene, an expression or a raw volume; optionally write the mesh and print its stats.
+    /// Mesh a scene, an expression, a raw volume, a triangle mesh or a point cloud; optionally write the mesh and print its stats.
     Mesh(Box<MeshArgs>),
     /// List the built-in scenes, or print one scene's program.
     Scenes {
@@ -32,10 +32,10 @@ enum Command {
 
 /// The inputs other than --grid, which the volume's layout options make no sense with. (A plain
 /// `requires = "grid"` is not enforced by clap for a member of the input group.)
-const NOT_GRID: [&str; 3] = ["scene", "expr", "expr_file"];
+const NOT_GRID: [&str; 5] = ["scene", "expr", "expr_file", "mesh", "points"];
 
 #[derive(clap::Args)]
-#[command(group(ArgGroup::new("input").required(true).args(["scene", "expr", "expr_file", "grid"])))]
+#[command(group(ArgGroup::new("input").required(true).args(["scene", "expr", "expr_file", "grid", "mesh", "points"])))]
 struct MeshArgs {
     /// A built-in scene (see `isoforge scenes`), meshed in its own bounds.
     #[arg(long)]
@@ -46,6 +46,14 @@ struct MeshArgs {
     /// A file holding a program in the expression language (like --expr).
     #[arg(long, value_name = "FILE")]
     expr_file: Option<PathBuf>,
+    /// A closed triangle mesh to remesh (.obj, .stl, .ply, .off). Without --bounds the grid covers
+    /// its bounding box padded by two cells, --res cells along the longest side.
+    #[arg(long, value_name = "FILE")]
+    mesh: Option<PathBuf>,
+    /// An oriented point cloud to reconstruct a surface from (.ply with nx ny nz, or .xyz text
+    /// `x y z nx ny nz`); bounds as for --mesh.
+    #[arg(long, value_name = "FILE")]
+    points: Option<PathBuf>,
     /// A raw volume: samples without a header, little-endian, x fastest (needs --dims).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["bounds", "res"])]
     grid: Option<PathBuf>,
@@ -214,8 +222,16 @@ fn mesh_input(args: &MeshArgs, request: &Request) -> Result<Output, Error> {
         let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
         let values = grid::samples_from_bytes(&bytes, dtype, &grid)?;
         pipeline::mesh_samples(&values, &grid, request)
+    } else if let Some(path) = &args.mesh {
+        let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+        let mesh = input::read_mesh(&bytes, path.to_str()).map_err(|e| in_file(path, e))?;
+        pipeline::mesh_triangles(&mesh, request)
+    } else if let Some(path) = &args.points {
+        let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+        let cloud = input::read_points(&bytes, path.to_str()).map_err(|e| in_file(path, e))?;
+        pipeline::mesh_points(&cloud, request)
     } else {
-        Err(Error::InvalidOption("give one of --scene, --expr, --expr-file, --grid".into()))
+        Err(Error::InvalidOption("give one of --scene, --expr, --expr-file, --grid, --mesh, --points".into()))
     }
 }
 
@@ -230,6 +246,14 @@ where
         .collect::<Result<Vec<T>, String>>()?;
     let n = values.len();
     values.try_into().map_err(|_| format!("expected {N} comma-separated numbers, got {n}"))
+}
+
+/// A reader's error, prefixed with the file it is about.
+fn in_file(path: &Path, e: Error) -> Error {
+    match e {
+        Error::Io(msg) => Error::Io(format!("{}: {msg}", path.display())),
+        e => e,
+    }
 }
 
 fn io_error(path: &Path, e: std::io::Error) -> Error {

@@ -5,11 +5,17 @@
 //!
 //! The topology is exactly plain MC's on the same grid (same polygons from [`crate::tables`]), so
 //! EMC inherits its watertightness; only the geometry inside each cell changes.
+//!
+//! Besides fields and samples, EMC meshes triangle meshes ([`mesh_source::remesh`], ray casting)
+//! and oriented point clouds ([`point_source::reconstruct`], tangent planes): the paper's §3.1
+//! directed distances for its remeshing (§5.3) and reconstruction (§5.2) applications.
 
 pub mod crust;
 pub mod edges;
 pub mod feature;
 pub mod flip;
+pub mod mesh_source;
+pub mod point_source;
 
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
@@ -60,7 +66,7 @@ impl Default for EmcOptions {
 }
 
 impl EmcOptions {
-    fn validate(&self) -> Result<(), Error> {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
         let check = |name: &str, v: f32| {
             if (-1.0..=1.0).contains(&v) {
                 Ok(())
@@ -253,20 +259,33 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
                         // One bad solve must not throw a spike: the point stays inside its cell
-                        // (strictly, so no fan triangle lies in a cell face), or, where the planes
-                        // meet just outside it and clamping would fold the fan, within half a cell.
+                        // (strictly, so no fan triangle lies in a cell face) or within half a cell
+                        // of it. Candidates, best first: the point slid along its feature line
+                        // into the cell (an edge's planes fix it only up to that line, so this
+                        // keeps it on the edge where clamping would pull it off; a corner must
+                        // already lie in the cell); then the point clamped into the cell, or into
+                        // the cell grown by half a cell. Sliding along the line out of the cell
+                        // (before or after clamping) made fans cut their neighbours' on the gyroid
+                        // at 24. The first with a valid fan is taken; where none works, the
+                        // component stays plain MC.
                         let solved = feature_point(&pts, &nrm, kind);
                         let inset = grid.spacing * 1e-2;
-                        let mut f = solved.clamp(cell_min + inset, cell_max - inset);
-                        if !fan_is_valid(f, &pts, &nrm) {
-                            let margin = grid.spacing * 0.5;
-                            f = solved.clamp(cell_min - margin, cell_max + margin);
-                        }
-                        // Where neither works, the component stays plain MC.
-                        if fan_is_valid(f, &pts, &nrm) {
-                            feature = Some((f, kind));
-                        } else {
-                            out.rejected_features += 1;
+                        let (inner_min, inner_max) = (cell_min + inset, cell_max - inset);
+                        let margin = grid.spacing * 0.5;
+                        let (grown_min, grown_max) = (cell_min - margin, cell_max + margin);
+                        let line = if kind == FeatureKind::Edge { edge_direction(&nrm) } else { None };
+                        let on_feature = |lo: Vec3, hi: Vec3| match line {
+                            Some(dir) => slide_into_box(solved, dir, lo, hi).map(|p| p.clamp(lo, hi)),
+                            None => (solved.cmpge(lo).all() && solved.cmple(hi).all()).then_some(solved),
+                        };
+                        let candidates = [
+                            on_feature(inner_min, inner_max),
+                            Some(solved.clamp(inner_min, inner_max)),
+                            Some(solved.clamp(grown_min, grown_max)),
+                        ];
+                        match candidates.into_iter().flatten().find(|&c| fan_is_valid(c, &pts, &nrm)) {
+                            Some(f) => feature = Some((f, kind)),
+                            None => out.rejected_features += 1,
                         }
                     }
                     plans.push(Plan { by_edge, ids, pts, nrm, group, feature });
@@ -364,6 +383,38 @@ impl Plan {
             }
         }
     }
+}
+
+/// Direction of the feature line of an edge cell: across the two most different normals.
+fn edge_direction(normals: &[Vec3]) -> Option<Vec3> {
+    let mut best = (f32::INFINITY, Vec3::ZERO);
+    for i in 0..normals.len() {
+        for j in i + 1..normals.len() {
+            let d = normals[i].dot(normals[j]);
+            if d < best.0 {
+                best = (d, normals[i].cross(normals[j]));
+            }
+        }
+    }
+    let dir = best.1.normalize_or_zero();
+    (dir != Vec3::ZERO).then_some(dir)
+}
+
+/// The point of the line `p + s dir` inside `[lo, hi]` nearest to `p`, if the line meets the box.
+fn slide_into_box(p: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<Vec3> {
+    let (mut s0, mut s1) = (f32::NEG_INFINITY, f32::INFINITY);
+    for a in 0..3 {
+        if dir[a] == 0.0 {
+            if p[a] < lo[a] || p[a] > hi[a] {
+                return None;
+            }
+            continue;
+        }
+        let (t0, t1) = ((lo[a] - p[a]) / dir[a], (hi[a] - p[a]) / dir[a]);
+        s0 = s0.max(t0.min(t1));
+        s1 = s1.min(t0.max(t1));
+    }
+    (s0 <= s1).then(|| p + dir * 0.0f32.clamp(s0, s1))
 }
 
 /// A fan around `center` is valid when every triangle faces the way the field's normals at its

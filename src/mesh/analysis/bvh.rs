@@ -154,6 +154,46 @@ impl Bvh {
         }
     }
 
+    /// Depth-first walk for queries against one object (a ray, a point): `key(state, bounds)` is
+    /// `None` for a node whose subtree cannot matter and otherwise an ordering key (a distance along
+    /// the ray, a squared distance to the point); children are visited smallest key first, and a
+    /// node's key is asked again just before it is entered, so a `state` that improved meanwhile
+    /// (a nearer hit) prunes it. `item(state, id)` is called for every item of each entered leaf.
+    pub fn walk<S>(
+        &self,
+        state: &mut S,
+        key: impl Fn(&S, &Aabb) -> Option<f32>,
+        mut item: impl FnMut(&mut S, u32),
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = vec![0u32];
+        while let Some(id) = stack.pop() {
+            let node = self.nodes[id as usize];
+            if key(state, &node.bounds).is_none() {
+                continue;
+            }
+            if node.count > 0 {
+                for &i in self.leaf_items(&node) {
+                    item(state, i);
+                }
+                continue;
+            }
+            let (l, r) = (id + 1, node.first_or_right);
+            let (kl, kr) =
+                (key(state, &self.nodes[l as usize].bounds), key(state, &self.nodes[r as usize].bounds));
+            // Pushed last, popped first: the nearer child.
+            match (kl, kr) {
+                (Some(a), Some(b)) if a <= b => stack.extend([r, l]),
+                (Some(_), Some(_)) => stack.extend([l, r]),
+                (Some(_), None) => stack.push(l),
+                (None, Some(_)) => stack.push(r),
+                (None, None) => {}
+            }
+        }
+    }
+
     fn leaf_items(&self, node: &Node) -> &[u32] {
         let start = node.first_or_right as usize;
         &self.items[start..start + node.count as usize]
@@ -212,6 +252,31 @@ mod tests {
                 assert!(expected.len() > 100, "the test needs overlaps to mean anything");
             }
         }
+    }
+
+    #[test]
+    fn walk_finds_the_nearest_box_like_brute_force() {
+        let b = boxes(300);
+        let bvh = Bvh::build(&b);
+        let dist2 = |p: Vec3, a: &Aabb| (a.min - p).max(p - a.max).max(Vec3::ZERO).length_squared();
+        for q in [Vec3::ZERO, Vec3::splat(5.0), Vec3::new(12.0, -3.0, 4.0)] {
+            let mut best = (f32::INFINITY, u32::MAX, 0usize);
+            bvh.walk(
+                &mut best,
+                |best, bounds| Some(dist2(q, bounds)).filter(|&d| d <= best.0),
+                |best, i| {
+                    best.2 += 1;
+                    let d = dist2(q, &b[i as usize]);
+                    if d < best.0 {
+                        (best.0, best.1) = (d, i);
+                    }
+                },
+            );
+            let expected = b.iter().map(|a| dist2(q, a)).fold(f32::INFINITY, f32::min);
+            assert_eq!(best.0, expected);
+            assert!(best.2 < 150, "pruning visited {} of 300 boxes", best.2);
+        }
+        Bvh::build(&[]).walk(&mut (), |_, _| Some(0.0), |_, _| panic!("no items"));
     }
 
     #[test]

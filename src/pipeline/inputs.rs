@@ -1,0 +1,167 @@
+//! Requests on inputs that are not fields: remeshing a triangle mesh and reconstructing a surface
+//! from an oriented point cloud (EMC's own applications, paper §5.3 and §5.2). `method: "emc"`
+//! gives the directed distances (ray hits, tangent planes); `"mc"` plain Marching Cubes on the same
+//! grid's signed values, the baseline; `"dmc"` the octree over the trilinear interpolant of those
+//! same values.
+//!
+//! Without `bounds` the grid covers the input's bounding box padded by two cells, `res` cells
+//! along its longest side ([`padded_grid`]). The error statistics measure against the input itself:
+//! the signed distance to the mesh, or to the tangent plane of the nearest sample.
+
+use super::{Meshed, Method, Output, Request};
+use crate::emc::mesh_source::{self, mesh_bounds, padded_grid, MeshBvh};
+use crate::emc::point_source::{self, PointIndex};
+use crate::error::Error;
+use crate::field::{Field, SampleGradient, SampledField};
+use crate::grid::Grid;
+use crate::input::PointCloud;
+use crate::mesh::Mesh;
+use crate::{dmc, mc};
+use glam::Vec3;
+
+/// The request's bounds, or the input's padded by two cells.
+fn input_grid(bounds: (Vec3, Vec3), request: &Request) -> Result<Grid, Error> {
+    let grid = match request.bounds {
+        Some((min, max)) => Grid::with_resolution(min, max, request.res)?,
+        None => padded_grid(bounds.0, bounds.1, request.res)?,
+    };
+    grid.check_size(request.max_cells)?;
+    Ok(grid)
+}
+
+/// DMC over the trilinear interpolant of the same signed values plain MC meshes: the inputs' signs
+/// are decided per grid point (votes of rays through the grid), which a point query cannot match
+/// near the input's edges. The octree's finest level is the grid's.
+fn dmc_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Meshed, Error> {
+    let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
+    let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
+    let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
+    Ok(Meshed::from_dmc(mesh, stats))
+}
+
+/// Grid methods report the grid's cells along its longest side; DMC its finest octree level.
+fn reported_res(grid: &Grid, request: &Request) -> usize {
+    match request.method {
+        Method::Dmc => request.reported_res(),
+        _ => grid.cells.iter().copied().max().unwrap_or(0),
+    }
+}
+
+fn iso_must_be_zero(request: &Request, what: &str) -> Result<(), Error> {
+    if request.iso != 0.0 {
+        return Err(Error::InvalidOption(format!("iso must be 0 when {what}, got {}", request.iso)));
+    }
+    Ok(())
+}
+
+/// Remeshes a closed triangle mesh (counter-clockwise seen from outside, or consistently the
+/// other way round, which is detected and turned around).
+pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
+    iso_must_be_zero(request, "remeshing a triangle mesh (the surface is the mesh)")?;
+    let bounds = mesh_bounds(mesh);
+    let grid = input_grid(bounds, request)?;
+    let source = MeshBvh::new(mesh)?;
+    let meshed = match request.method {
+        Method::Mc => {
+            let t0 = web_time::Instant::now();
+            let values = mesh_source::grid_values(&source, &grid);
+            let sample_ms = mc::ms_since(t0);
+            let (mesh, timings) = mc::mesh_samples(&values, &grid, &request.mc_options())?;
+            Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+        }
+        Method::Emc => {
+            let (out, timings) = mesh_source::remesh(mesh, &grid, &request.emc_options())?;
+            Meshed::from_emc(out, timings)
+        }
+        Method::Dmc => dmc_on_samples(&mesh_source::grid_values(&source, &grid), &grid, request)?,
+    };
+    let res = reported_res(&grid, request);
+    Ok(meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis))
+}
+
+/// Reconstructs the surface an oriented point cloud samples (normals pointing out of the solid;
+/// they are scaled to unit length here).
+pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Error> {
+    iso_must_be_zero(request, "reconstructing from points (the surface is the samples' tangent planes)")?;
+    let cloud = cloud.clone().normalized()?;
+    cloud.validate()?;
+    let grid = input_grid(cloud.bounds(), request)?;
+    let index = PointIndex::new(&cloud)?;
+    let meshed = match request.method {
+        Method::Mc => {
+            let t0 = web_time::Instant::now();
+            let values = point_source::grid_values(&index, &grid);
+            let sample_ms = mc::ms_since(t0);
+            let (mesh, timings) = mc::mesh_samples(&values, &grid, &request.mc_options())?;
+            Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+        }
+        Method::Emc => {
+            let (out, timings) = point_source::reconstruct(&cloud, &grid, &request.emc_options())?;
+            Meshed::from_emc(out, timings)
+        }
+        Method::Dmc => dmc_on_samples(&point_source::grid_values(&index, &grid), &grid, request)?,
+    };
+    let res = reported_res(&grid, request);
+    Ok(meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis))
+}
+
+/// Signed distance to a triangle mesh, the truth a remeshed mesh is measured against: the
+/// distance to the nearest point, negative where the offset from that point faces against its
+/// triangle's normal. The gradient points from the nearest point, so one projection step lands on
+/// the mesh; within `on_surface` of the mesh (where that direction is rounding noise) it is the
+/// nearest triangle's normal.
+pub struct MeshDistance<'a> {
+    pub mesh: &'a MeshBvh,
+    pub on_surface: f32,
+}
+
+impl<'a> MeshDistance<'a> {
+    /// `on_surface` is 1e-5 of the diagonal of `bounds`, a hundred times the tolerance of the
+    /// projections in [`crate::mesh::analysis::surface_error`].
+    pub fn new(mesh: &'a MeshBvh, bounds: (Vec3, Vec3)) -> MeshDistance<'a> {
+        MeshDistance { mesh, on_surface: 1e-5 * (bounds.1 - bounds.0).length() }
+    }
+}
+
+impl Field for MeshDistance<'_> {
+    fn value(&self, p: Vec3) -> f32 {
+        match self.mesh.closest_point(p) {
+            Some((c, t)) => {
+                let d = (p - c).length();
+                if self.mesh.normal(t).dot(p - c) < 0.0 {
+                    -d
+                } else {
+                    d
+                }
+            }
+            None => f32::INFINITY,
+        }
+    }
+
+    fn gradient(&self, p: Vec3) -> Option<Vec3> {
+        let (c, t) = self.mesh.closest_point(p)?;
+        let n = self.mesh.normal(t);
+        let away = (p - c).normalize_or_zero();
+        Some(if (p - c).length() <= self.on_surface || away == Vec3::ZERO {
+            n
+        } else if n.dot(away) < 0.0 {
+            -away
+        } else {
+            away
+        })
+    }
+}
+
+/// Distance to the tangent plane of the nearest sample (§3.1), the truth a reconstruction is
+/// measured against.
+pub struct PlaneDistance<'a>(pub &'a PointIndex);
+
+impl Field for PlaneDistance<'_> {
+    fn value(&self, p: Vec3) -> f32 {
+        self.0.plane_distance(self.0.nearest(p, None), p)
+    }
+
+    fn gradient(&self, p: Vec3) -> Option<Vec3> {
+        Some(self.0.sample(self.0.nearest(p, None)).1)
+    }
+}

@@ -1,0 +1,259 @@
+//! Triangle meshes and point clouds through the pipeline the CLI (`--mesh`, `--points`) and the
+//! wasm API (`meshTriangles`, `meshPoints`) share: remeshing reproduces a closed mesh with its
+//! sharp edges, a sampled surface is reconstructed near the truth, and EMC is compared with plain
+//! MC on the same grid in the same test.
+
+mod common;
+
+use common::{assert_watertight, Rng};
+use isoforge::input::PointCloud;
+use isoforge::pipeline::{self, Method, Output, Request};
+use isoforge::stats::AnalysisOptions;
+use isoforge::{Mesh, Vec3};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+
+fn request(method: Method, res: usize) -> Request {
+    Request {
+        method,
+        res,
+        analysis: AnalysisOptions { self_intersections: true, surface_error: true },
+        ..Request::default()
+    }
+}
+
+/// Total length of the feature lines.
+fn feature_length(out: &Output) -> f32 {
+    let p = &out.mesh.positions;
+    out.feature_edges.iter().map(|&[a, b]| p[a as usize].distance(p[b as usize])).sum()
+}
+
+/// A regular octahedron of circumradius `r`, turned off the grid axes and moved off the origin.
+fn octahedron(r: f32) -> Mesh {
+    let rotation = glam::Quat::from_axis_angle(Vec3::new(2.0, -1.0, 3.0).normalize(), 0.5);
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    let positions = axes.iter().map(|&a| rotation * (a * r) + Vec3::new(0.02, -0.01, 0.03)).collect();
+    let mut triangles = Vec::new();
+    for (x, y, z) in
+        [(0u32, 2u32, 4u32), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+    {
+        triangles.push([x, y, z]);
+    }
+    Mesh { positions, normals: Vec::new(), triangles }
+}
+
+#[test]
+fn an_octahedron_remeshes_closed_with_its_edges_as_feature_lines() {
+    let input = octahedron(0.8);
+    let emc = pipeline::mesh_triangles(&input, &request(Method::Emc, 32)).unwrap();
+    let mc = pipeline::mesh_triangles(&input, &request(Method::Mc, 32)).unwrap();
+    let topo = assert_watertight(&emc.mesh, "remeshed octahedron");
+    assert_eq!((topo.euler, topo.components), (2, 1));
+    assert_eq!(emc.stats.self_intersections, Some(0));
+    assert_eq!(assert_watertight(&mc.mesh, "MC of the octahedron").euler, 2);
+    // Grid of 32 cells over the bounding box plus two cells each side.
+    let h = (emc.mesh.positions.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p))
+        - emc.mesh.positions.iter().fold(Vec3::INFINITY, |a, &p| a.min(p)))
+    .max_element()
+        / 28.0;
+    let (e, m) = (&emc.stats, &mc.stats);
+    let (e95, m95) = (e.normal_dev_deg_p95.unwrap(), m.normal_dev_deg_p95.unwrap());
+    let (edist, mdist) = (e.dist_max.unwrap(), m.dist_max.unwrap());
+    let length = feature_length(&emc);
+    let edges = 12.0 * 0.8 * 2f32.sqrt();
+    eprintln!(
+        "octahedron res 32: EMC {} triangles, normal p95 {e95:.3}°, distance max {:.3} cells, \
+         {} corners, feature lines {length:.3} of {edges:.3}; MC {} triangles, normal p95 {m95:.2}°, \
+         distance max {:.3} cells",
+        e.triangles,
+        edist / h as f64,
+        e.corner_features,
+        m.triangles,
+        mdist / h as f64
+    );
+    // Measured: 3.3x (p95), 1.43x (max distance, 0.26 cells: feature points clamped into their
+    // cells where the faces' planes meet outside them).
+    assert!(e95 * 3.0 < m95, "normal p95 {e95}° against MC's {m95}°");
+    assert!(edist * 1.3 < mdist, "distance {edist} against MC's {mdist}");
+    assert!(edist < 0.3 * h as f64, "distance {edist} is more than 0.3 cells");
+    assert!(e.triangles as f64 <= 1.2 * m.triangles as f64);
+    assert_eq!(e.corner_features, 6, "the six vertices");
+    assert!(length > 0.8 * edges && length < 1.02 * edges, "feature lines {length} of {edges}");
+}
+
+#[test]
+fn remeshing_an_emc_mesh_of_a_scene_reproduces_it() {
+    for name in ["rotated_box", "fandisk"] {
+        let scene = pipeline::mesh_scene(name, &request(Method::Emc, 32)).unwrap();
+        let input_topo = assert_watertight(&scene.mesh, name);
+        let out = pipeline::mesh_triangles(&scene.mesh, &request(Method::Emc, 40)).unwrap();
+        let what = format!("{name} remeshed");
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (input_topo.euler, input_topo.components), "{what}");
+        assert_eq!(out.stats.self_intersections, Some(0), "{what}");
+        // Cells of the remeshing grid: 40 along the input's longest side plus two on each end.
+        let h = {
+            let (lo, hi) = scene
+                .mesh
+                .positions
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            (hi - lo).max_element() as f64 / 36.0
+        };
+        let dist = out.stats.dist_max.unwrap() / h;
+        let volume = out.stats.volume / scene.stats.volume;
+        let (before, after) = (feature_length(&scene), feature_length(&out));
+        eprintln!(
+            "{what}: distance max {dist:.3} cells, volume ratio {volume:.4}, feature lines {before:.3} → {after:.3}"
+        );
+        // Feature points clamped into their cells (where the planes meet outside) sit off the
+        // input's edges; everything else is on it.
+        assert!(dist < 0.4, "{what}: {dist} cells off the input");
+        assert!((volume - 1.0).abs() < 0.01, "{what}: volume ratio {volume}");
+        // The input's sharp edges come back as feature lines.
+        assert!(after > 0.8 * before && after < 1.2 * before, "{what}: feature lines {before} → {after}");
+    }
+}
+
+/// `n` points on a sphere of radius `r` about `c` (a Fibonacci lattice), normals outward.
+fn sphere_cloud(n: usize, r: f32, c: Vec3) -> PointCloud {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let mut cloud = PointCloud::default();
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let rho = (1.0 - z * z).sqrt();
+        let n = Vec3::new(rho * (golden * i as f32).cos(), rho * (golden * i as f32).sin(), z);
+        cloud.positions.push(c + n * r);
+        cloud.normals.push(n);
+    }
+    cloud
+}
+
+#[test]
+fn a_sampled_sphere_reconstructs_closed_near_the_sphere() {
+    let c = Vec3::new(0.03, -0.02, 0.01);
+    let cloud = sphere_cloud(20000, 0.7, c);
+    for method in [Method::Emc, Method::Mc] {
+        let out = pipeline::mesh_points(&cloud, &request(method, 32)).unwrap();
+        let what = format!("sphere from points, {}", method.name());
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        let h = 1.4 / 28.0;
+        let off = out.mesh.positions.iter().map(|&p| ((p - c).length() - 0.7).abs()).fold(0.0, f32::max) / h;
+        eprintln!(
+            "{what}: {} triangles, vertices at most {off:.3} cells off the sphere",
+            out.stats.triangles
+        );
+        assert!(off < 0.05, "{what}: a vertex is {off} cells off the sphere");
+    }
+}
+
+#[test]
+fn a_sampled_box_reconstructs_with_its_corners() {
+    let mut rng = Rng::new(11);
+    let mut cloud = PointCloud::default();
+    let half = Vec3::new(0.5, 0.4, 0.3);
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            for _ in 0..5000 {
+                let mut p =
+                    Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
+                p[axis] = side * half[axis];
+                let mut n = Vec3::ZERO;
+                n[axis] = side;
+                let rotation = glam::Quat::from_axis_angle(Vec3::new(1.0, 1.0, 2.0).normalize(), 0.4);
+                cloud.positions.push(rotation * p);
+                cloud.normals.push(rotation * n);
+            }
+        }
+    }
+    let emc = pipeline::mesh_points(&cloud, &request(Method::Emc, 32)).unwrap();
+    let mc = pipeline::mesh_points(&cloud, &request(Method::Mc, 32)).unwrap();
+    assert_eq!(assert_watertight(&emc.mesh, "box from points").euler, 2);
+    assert_eq!(emc.stats.self_intersections, Some(0));
+    assert_eq!(emc.stats.corner_features, 8);
+    let (e95, m95) = (emc.stats.normal_dev_deg_p95.unwrap(), mc.stats.normal_dev_deg_p95.unwrap());
+    eprintln!("box from 30000 points res 32: normal p95 EMC {e95:.2}°, MC {m95:.2}°");
+    assert!(e95 * 3.0 < m95, "normal p95 {e95}° against MC's {m95}°");
+}
+
+#[test]
+fn inputs_that_cannot_be_meshed_are_refused_with_reasons() {
+    let fails = |r: Result<Output, isoforge::Error>| r.unwrap_err().to_string();
+    let shifted = Request { iso: 0.1, ..request(Method::Emc, 16) };
+    assert!(fails(pipeline::mesh_triangles(&octahedron(1.0), &shifted)).contains("iso must be 0"));
+    assert!(
+        fails(pipeline::mesh_points(&sphere_cloud(100, 1.0, Vec3::ZERO), &shifted)).contains("iso must be 0")
+    );
+    let mut bad = octahedron(1.0);
+    bad.triangles.push([0, 1, 6]);
+    assert!(fails(pipeline::mesh_triangles(&bad, &request(Method::Emc, 16)))
+        .contains("refers past the 6 vertices"));
+    let mut cloud = sphere_cloud(100, 1.0, Vec3::ZERO);
+    cloud.normals.pop();
+    assert!(
+        fails(pipeline::mesh_points(&cloud, &request(Method::Mc, 16))).contains("every point needs a normal")
+    );
+    let mut cloud = sphere_cloud(100, 1.0, Vec3::ZERO);
+    cloud.normals[7] = Vec3::ZERO;
+    assert!(fails(pipeline::mesh_points(&cloud, &request(Method::Emc, 16))).contains("point 7"));
+    assert!(
+        fails(pipeline::mesh_points(&PointCloud::default(), &request(Method::Emc, 16))).contains("no points")
+    );
+    assert!(fails(pipeline::mesh_triangles(&octahedron(1.0), &request(Method::Emc, 4)))
+        .contains("at least 5 cells"));
+}
+
+/// The wasm entry points on the same inputs: typed arrays in, a closed mesh out.
+#[cfg(target_arch = "wasm32")]
+mod wasm_api {
+    use super::*;
+    use isoforge::wasm::{mesh_points, mesh_triangles};
+    use wasm_bindgen::{JsCast, JsValue};
+    use wasm_bindgen_test::wasm_bindgen_test as test;
+
+    fn options(method: &str) -> JsValue {
+        let o = js_sys::Object::new();
+        js_sys::Reflect::set(&o, &"method".into(), &method.into()).unwrap();
+        js_sys::Reflect::set(&o, &"res".into(), &24.into()).unwrap();
+        o.into()
+    }
+
+    fn get(v: &JsValue, key: &str) -> JsValue {
+        js_sys::Reflect::get(v, &key.into()).unwrap()
+    }
+
+    fn flat(points: &[Vec3]) -> Vec<f32> {
+        points.iter().flat_map(|p| p.to_array()).collect()
+    }
+
+    #[test]
+    fn mesh_triangles_remeshes_typed_arrays() {
+        let m = octahedron(0.8);
+        let indices: Vec<u32> = m.triangles.iter().flatten().copied().collect();
+        let r = mesh_triangles(&flat(&m.positions), &indices, options("emc")).unwrap();
+        let stats = get(&r, "stats");
+        assert_eq!(get(&stats, "closed_manifold"), JsValue::TRUE);
+        assert_eq!(get(&stats, "euler").as_f64(), Some(2.0));
+        assert_eq!(get(&stats, "corner_features").as_f64(), Some(6.0));
+        assert!(get(&r, "featureEdges").unchecked_into::<js_sys::Uint32Array>().length() > 0);
+        let err = mesh_triangles(&[0.0; 7], &indices, JsValue::UNDEFINED).unwrap_err();
+        let message = err.unchecked_into::<js_sys::Error>().message();
+        assert!(String::from(message).contains("xyz triples"));
+    }
+
+    #[test]
+    fn mesh_points_reconstructs_typed_arrays() {
+        let cloud = sphere_cloud(5000, 0.7, Vec3::ZERO);
+        let r = mesh_points(&flat(&cloud.positions), &flat(&cloud.normals), options("emc")).unwrap();
+        let stats = get(&r, "stats");
+        assert_eq!(get(&stats, "closed_manifold"), JsValue::TRUE);
+        assert_eq!(get(&stats, "euler").as_f64(), Some(2.0));
+        let err = mesh_points(&flat(&cloud.positions), &[0.0, 0.0, 1.0], JsValue::UNDEFINED).unwrap_err();
+        let message = String::from(err.unchecked_into::<js_sys::Error>().message());
+        assert!(message.contains("every point needs a normal"), "{message}");
+    }
+}
