@@ -16,6 +16,9 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
+mod export;
+pub use export::export_mesh;
+
 #[wasm_bindgen(start)]
 fn start() {
     console_error_panic_hook::set_once();
