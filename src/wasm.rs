@@ -87,6 +87,12 @@ export type SampleGradientName = "trilinear" | "central";
  */
 export type BatchFieldFunction = (points: Float32Array) => Float32Array | number[];
 
+/** Nanoseconds per point (per box for `interval`) of each evaluation mode: see measureEvaluator. */
+export interface EvaluatorSpeed {
+  treeWalk: number; value: number; valueGradient: number; batch: number; interval: number;
+  instructions: number;
+}
+
 /** Numbers describing one run; the same keys as the CLI's `--stats` JSON. */
 export interface MeshStats {
   method: string; res: number; vertices: number; triangles: number;
@@ -328,11 +334,63 @@ impl Shape {
         vec![v, g.x, g.y, g.z]
     }
 
+    /// Values at many points at once (`points` = xyz triples): far cheaper per point than
+    /// `value`, which crosses the JavaScript boundary once per call.
+    pub fn values(&self, points: &[f32]) -> Result<Vec<f32>, JsValue> {
+        let points = triples(points)?;
+        let mut out = vec![0.0; points.len()];
+        self.program.eval_many(&points, &mut out);
+        Ok(out)
+    }
+
+    /// `[value, dx, dy, dz]` for each point of `points` (xyz triples), gradients exact.
+    #[wasm_bindgen(js_name = valuesAndGradients)]
+    pub fn values_and_gradients(&self, points: &[f32]) -> Result<Vec<f32>, JsValue> {
+        let points = triples(points)?;
+        let mut out = Vec::with_capacity(points.len() * 4);
+        for p in points {
+            let (v, g) = self.program.eval_grad(p);
+            out.extend_from_slice(&[v, g.x, g.y, g.z]);
+        }
+        Ok(out)
+    }
+
+    /// `[lo, hi]`: conservative bounds of the value over the box between the corners (x0, y0, z0)
+    /// and (x1, y1, z1); the surface cannot be in the box if they do not straddle 0.
+    pub fn bounds(&self, x0: f32, y0: f32, z0: f32, x1: f32, y1: f32, z1: f32) -> Vec<f32> {
+        let (lo, hi) = self.program.eval_interval(Vec3::new(x0, y0, z0), Vec3::new(x1, y1, z1));
+        vec![lo, hi]
+    }
+
     /// Instructions on the compiled tape (after constant folding and sharing repeated parts).
     #[wasm_bindgen(getter, js_name = instructionCount)]
     pub fn instruction_count(&self) -> usize {
         self.program.instruction_count()
     }
+}
+
+/// Points given as a flat array of xyz triples.
+fn triples(points: &[f32]) -> Result<Vec<Vec3>, JsValue> {
+    if points.len() % 3 != 0 {
+        return Err(js_error(Error::InvalidOption(format!(
+            "points must be xyz triples, got {} numbers",
+            points.len()
+        ))));
+    }
+    Ok(points.chunks_exact(3).map(Vec3::from_slice).collect())
+}
+
+/// Times the evaluator on this machine: nanoseconds per point of the reference tree walk, of
+/// `value`, `value + gradient`, 64-point batches, and per box of interval bounds, for `text` over
+/// `count` points, each mode run for at least `minMs` milliseconds (performance.now()). For
+/// benchmarks (`scripts/bench-browser.mjs`); it blocks for about five times `minMs`.
+#[wasm_bindgen(js_name = measureEvaluator, unchecked_return_type = "EvaluatorSpeed")]
+pub fn measure_evaluator(text: &str, count: usize, min_ms: f64) -> Result<JsValue, JsValue> {
+    let performance = js_sys::Reflect::get(&js_sys::global(), &"performance".into())?;
+    let now_fn: js_sys::Function = js_sys::Reflect::get(&performance, &"now".into())?.dyn_into()?;
+    let now = || now_fn.call0(&performance).ok().and_then(|v| v.as_f64()).unwrap_or(0.0);
+    let speed = expr::speed::measure(text, count, min_ms, &now).map_err(js_error)?;
+    serde_wasm_bindgen::to_value(&speed).map_err(|e| js_error(e.to_string()))
 }
 
 /// Compiles a program in the expression language. A malformed program throws an `Error` whose
