@@ -5,7 +5,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFile } from 'node:child_process';
-import { existsSync, readFileSync } from 'node:fs';
+import { existsSync, readdirSync, readFileSync } from 'node:fs';
 import { promisify } from 'node:util';
 import { serve, launch } from '../../scripts/browser.mjs';
 
@@ -31,7 +31,7 @@ after(async () => {
   server?.close();
 });
 
-test('the installed package has every file its package.json points to', () => {
+test('the installed package has every file its package.json and its JavaScript point to', () => {
   const installed = `${APP}/node_modules/isoforge`;
   const manifest = JSON.parse(readFileSync(`${installed}/package.json`, 'utf8'));
   const targets = [manifest.main, manifest.module, manifest.types, 'README.md'];
@@ -41,6 +41,16 @@ test('the installed package has every file its package.json points to', () => {
   for (const file of targets) {
     assert.ok(existsSync(`${installed}/${file}`), `${file} is named by package.json but was not installed`);
   }
+  // And every file the shipped JavaScript loads by a relative path (imports, the wasm, the worker).
+  const relative = /(?:from\s*|import\s*\(\s*|new URL\(\s*)['"]((?:\.\/)?[\w.-]+\.(?:js|wasm))['"]/g;
+  let seen = 0;
+  for (const file of readdirSync(installed).filter((f) => f.endsWith('.js'))) {
+    for (const [, path] of readFileSync(`${installed}/${file}`, 'utf8').matchAll(relative)) {
+      seen++;
+      assert.ok(existsSync(`${installed}/${path}`), `${file} loads ${path}, which was not installed`);
+    }
+  }
+  assert.ok(seen >= 3, `only ${seen} relative loads found: the pattern no longer matches the package`);
 });
 
 /** The app's page, with every failed request and uncaught error collected into `errors`. */
