@@ -13,7 +13,7 @@ export class MeshingCancelled extends Error {
   }
 }
 
-export function createMesher({ workerUrl = new URL('./mesher-worker.js', import.meta.url) } = {}) {
+export function createMesher({ workerUrl } = {}) {
   let worker = null;
   let nextId = 1;
   const pending = new Map();
@@ -24,7 +24,10 @@ export function createMesher({ workerUrl = new URL('./mesher-worker.js', import.
   };
 
   const start = () => {
-    worker = new Worker(workerUrl, { type: 'module' });
+    // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
+    worker = workerUrl
+      ? new Worker(workerUrl, { type: 'module' })
+      : new Worker(new URL('./mesher-worker.js', import.meta.url), { type: 'module' });
     worker.onmessage = ({ data: { id, result, error } }) => {
       const job = pending.get(id);
       if (!job) return;

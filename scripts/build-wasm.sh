@@ -17,7 +17,8 @@ cp pkg-config/package.json pkg-config/README.md pkg/ 2>/dev/null || true
 # The plain-JavaScript parts, shipped as they are (and so also in www/pkg): the CSG builder
 # ("isoforge/csg"), the worker mesher ("isoforge/mesher") and the three.js helpers ("isoforge/three").
 cp pkg-config/*.js pkg-config/*.d.ts pkg/
-[ -f LICENSE ] && cp LICENSE pkg/
+# The licence texts npm users must receive with the package (MIT OR Apache-2.0).
+cp LICENSE-MIT LICENSE-APACHE pkg/
 
 log "copying the package and three.js into www/"
 rm -rf www/pkg www/vendor

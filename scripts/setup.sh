@@ -35,6 +35,13 @@ else
   log "wasm-bindgen-cli $want present"
 fi
 
+# Vite 8 (tests/vite-consumer, installed by its test) needs Node ^20.19 or >= 22.12.
+node_ok="$(node -e 'const [a, b] = process.versions.node.split(".").map(Number); console.log(a > 22 || (a === 22 && b >= 12) || (a === 20 && b >= 19) ? 1 : 0)')"
+if [ "$node_ok" != 1 ]; then
+  echo "Node $(node --version) is too old for the Vite consumer test: install Node 20.19+ or 22.12+" >&2
+  exit 1
+fi
+
 if [ ! -d node_modules ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
   log "installing npm dev tools (three.js, playwright-core)"
   npm ci --no-audit --no-fund --loglevel=error

@@ -16,7 +16,9 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
+mod export;
 mod inputs;
+pub use export::export_mesh;
 pub use inputs::{mesh_points, mesh_triangles};
 
 #[wasm_bindgen(start)]

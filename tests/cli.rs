@@ -188,7 +188,7 @@ fn raw_volumes_of_each_sample_type_are_meshed() {
 #[test]
 fn output_files_follow_their_extension() {
     let mut sizes = Vec::new();
-    for ext in ["obj", "stl", "ply"] {
+    for ext in ["obj", "stl", "ply", "glb"] {
         let path = scratch(&format!("torus.{ext}"));
         let _ = std::fs::remove_file(&path);
         let s = stats(&["mesh", "--scene", "torus", "--res", "16", "-o", path.to_str().unwrap()]);
@@ -200,6 +200,15 @@ fn output_files_follow_their_extension() {
                 assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), triangles);
             }
             "stl" => assert_eq!(bytes.len(), 84 + 50 * triangles),
+            "glb" => {
+                // Header says glTF 2 and the file's length; the JSON's index accessor counts the triangles.
+                assert_eq!(&bytes[..8], b"glTF\x02\0\0\0");
+                assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len());
+                let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+                let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+                let indices = json["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap() as usize;
+                assert_eq!(json["accessors"][indices]["count"].as_u64().unwrap() as usize, 3 * triangles);
+            }
             _ => assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n")),
         }
         sizes.push(bytes.len());

@@ -87,7 +87,7 @@ struct MeshArgs {
     /// Refuse grids with more cells than this.
     #[arg(long, default_value_t = isoforge::grid::DEFAULT_MAX_CELLS)]
     max_cells: u64,
-    /// Output file; the format follows the extension (.obj, .stl, .ply).
+    /// Output file; the format follows the extension (.obj, .stl, .ply, .glb).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Print one JSON object of statistics on stdout.

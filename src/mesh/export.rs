@@ -1,5 +1,6 @@
-//! Writing meshes in the three formats every mesh tool reads: OBJ (text, easy to diff), binary STL
-//! (what slicers and CAD expect) and binary PLY (compact, keeps vertex sharing and normals).
+//! Writing meshes in the formats mesh tools read: OBJ (text, easy to diff), binary STL (what
+//! slicers and CAD expect), binary PLY (compact, keeps vertex sharing and normals) and binary glTF
+//! (GLB, what web viewers load; see [`glb`]).
 //!
 //! Writers refuse inconsistent meshes (indices past the vertex list, a normal count that is neither
 //! zero nor one per vertex) with [`std::io::ErrorKind::InvalidInput`] instead of writing a file
@@ -9,6 +10,56 @@ use crate::error::Error;
 use crate::mesh::Mesh;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
+
+pub mod glb;
+pub use glb::write_glb;
+
+/// An export format, named as in file extensions and in the JavaScript `exportMesh`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Obj,
+    Stl,
+    Ply,
+    Glb,
+}
+
+impl Format {
+    pub const NAMES: [&'static str; 4] = ["obj", "stl", "ply", "glb"];
+
+    /// The format called `name` (`obj`, `stl`, `ply`, `glb`, any case).
+    pub fn parse(name: &str) -> Result<Format, Error> {
+        match name.to_ascii_lowercase().as_str() {
+            "obj" => Ok(Format::Obj),
+            "stl" => Ok(Format::Stl),
+            "ply" => Ok(Format::Ply),
+            "glb" => Ok(Format::Glb),
+            _ => Err(Error::UnknownName {
+                kind: "export format",
+                name: name.to_string(),
+                known: Format::NAMES.iter().map(|s| s.to_string()).collect(),
+            }),
+        }
+    }
+
+    /// The writer of this format.
+    pub fn writer(self) -> fn(&Mesh, &mut dyn Write) -> io::Result<()> {
+        match self {
+            Format::Obj => write_obj,
+            Format::Stl => write_stl_binary,
+            Format::Ply => write_ply_binary,
+            Format::Glb => write_glb,
+        }
+    }
+}
+
+/// The mesh encoded in `format` in memory, for the browser (a download) and for callers that
+/// send the bytes elsewhere. Inconsistent meshes are refused as by the writers.
+pub fn to_bytes(mesh: &Mesh, format: Format) -> Result<Vec<u8>, Error> {
+    let mut bytes = Vec::new();
+    format.writer()(mesh, &mut bytes)
+        .map_err(|e| Error::InvalidOption(format!("cannot export the mesh: {e}")))?;
+    Ok(bytes)
+}
 
 /// Wavefront OBJ: `v` lines, then `vn` lines when the mesh has normals, then `f` lines with 1-based
 /// indices (`f a//a b//b c//c` with normals, `f a b c` without). Coordinates are written with the
@@ -109,22 +160,19 @@ pub fn write_ply_binary(mesh: &Mesh, w: &mut dyn Write) -> io::Result<()> {
     w.flush()
 }
 
-/// Writes `mesh` to `path` in the format its extension names (`.obj`, `.stl`, `.ply`, any case).
+/// Writes `mesh` to `path` in the format its extension names (`.obj`, `.stl`, `.ply`, `.glb`,
+/// any case).
 pub fn write_by_extension(mesh: &Mesh, path: &Path) -> Result<(), Error> {
-    let extension =
-        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    let writer: fn(&Mesh, &mut dyn Write) -> io::Result<()> = match extension.as_str() {
-        "obj" => write_obj,
-        "stl" => write_stl_binary,
-        "ply" => write_ply_binary,
-        _ => {
-            return Err(Error::InvalidOption(format!(
-                "cannot export '{}': unknown extension '{}'; use .obj, .stl or .ply",
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or_default();
+    let writer = Format::parse(extension)
+        .map_err(|_| {
+            Error::InvalidOption(format!(
+                "cannot export '{}': unknown extension '{}'; use .obj, .stl, .ply or .glb",
                 path.display(),
-                extension
-            )))
-        }
-    };
+                extension.to_ascii_lowercase()
+            ))
+        })?
+        .writer();
     let io_error = |e: io::Error| Error::Io(format!("cannot write '{}': {e}", path.display()));
     let mut file = std::fs::File::create(path).map_err(io_error)?;
     writer(mesh, &mut file).map_err(io_error)
@@ -253,9 +301,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("isoforge-export-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let m = cube();
-        for (name, starts) in
-            [("a.obj", &b"# isoforge"[..]), ("b.STL", b"isoforge binary STL"), ("c.ply", b"ply\n")]
-        {
+        for (name, starts) in [
+            ("a.obj", &b"# isoforge"[..]),
+            ("b.STL", b"isoforge binary STL"),
+            ("c.ply", b"ply\n"),
+            ("d.glb", b"glTF"),
+        ] {
             let path = dir.join(name);
             write_by_extension(&m, &path).unwrap();
             let bytes = std::fs::read(&path).unwrap();
@@ -263,12 +314,31 @@ mod tests {
         }
         let err = write_by_extension(&m, &dir.join("d.gltf")).unwrap_err();
         assert!(
-            matches!(&err, Error::InvalidOption(msg) if msg.contains("'gltf'") && msg.contains(".ply")),
+            matches!(&err, Error::InvalidOption(msg) if msg.contains("'gltf'") && msg.contains(".glb")),
             "{err}"
         );
         assert!(matches!(write_by_extension(&m, &dir.join("noext")), Err(Error::InvalidOption(_))));
+        assert!(write_by_extension(&m, &dir.join("x.obj.gz")).is_err());
         let err = write_by_extension(&m, &dir.join("missing").join("e.obj")).unwrap_err();
         assert!(matches!(err, Error::Io(_)), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn to_bytes_matches_each_writer_and_format_names_parse() {
+        let (m, _) = mc_sphere(8);
+        for name in Format::NAMES {
+            let format = Format::parse(&name.to_uppercase()).unwrap();
+            let mut direct = Vec::new();
+            format.writer()(&m, &mut direct).unwrap();
+            assert_eq!(to_bytes(&m, format).unwrap(), direct, "{name}");
+        }
+        assert_eq!(to_bytes(&m, Format::Stl).unwrap().len(), 84 + 50 * m.triangle_count());
+        let err = Format::parse("gltf").unwrap_err();
+        assert!(err.to_string().contains("glb"), "{err}");
+        let mut bad = octahedron();
+        bad.normals = vec![Vec3::X];
+        let err = to_bytes(&bad, Format::Glb).unwrap_err();
+        assert!(err.to_string().contains("1 normals for 6 vertices"), "{err}");
     }
 }
