@@ -179,17 +179,52 @@ impl EdgeCache {
 /// Extracts the `options.iso` level set of a sampled grid.
 pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh, Error> {
     check_finite(values, grid)?;
-    let [nx, ny, _] = grid.points();
-    let [cx, cy, cz] = grid.cells;
-    let iso = options.iso;
     let mut mesh = Mesh::default();
-    let mut cache = EdgeCache::new(nx, ny);
     let fixed = triangle_table();
     // The 16 384-entry table is built only when the trilinear option asks for it.
     let with_faces: &[CellTriangles] =
         if options.topology == Topology::Trilinear { triangle_table_with_faces() } else { &[] };
-    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
+    for_each_crossed_cell(values, grid, options.iso, |cell, case, d, cache| {
+        let tris: &CellTriangles = match options.topology {
+            Topology::Fixed => &fixed[case as usize],
+            Topology::Trilinear => &with_faces[(case as usize) << 6 | joined_faces(case, d) as usize],
+        };
+        let mut ids = [NONE; 13];
+        let mut at = 0;
+        for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
+            let group = &tris.edges[3 * at..3 * (at + count as usize)];
+            at += count as usize;
+            for &e in group.iter().filter(|&&e| e != CENTER) {
+                if ids[e as usize] == NONE {
+                    ids[e as usize] = edge_vertex(cache, &mut mesh.positions, grid, cell, e as usize, d);
+                }
+            }
+            if group.contains(&CENTER) {
+                ids[CENTER as usize] = mesh.positions.len() as u32;
+                mesh.positions.push(polygon_center(&mesh.positions, group, &ids));
+            }
+            for t in group.chunks_exact(3) {
+                mesh.triangles.push([ids[t[0] as usize], ids[t[1] as usize], ids[t[2] as usize]]);
+            }
+        }
+    });
+    Ok(mesh)
+}
 
+/// Visits every cell the `iso` level crosses in the sweep order [`EdgeCache`] needs, with the
+/// cell's lowest corner, its case (bit `c` set when corner `c` is inside) and its values minus
+/// `iso`. Methods that build on Marching Cubes' vertices (issue 7's quality method) share it, so
+/// vertices are shared per grid edge exactly as here.
+pub(crate) fn for_each_crossed_cell(
+    values: &[f32],
+    grid: &Grid,
+    iso: f32,
+    mut visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
+) {
+    let [nx, ny, _] = grid.points();
+    let [cx, cy, cz] = grid.cells;
+    let mut cache = EdgeCache::new(nx, ny);
+    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     for k in 0..cz {
         if k > 0 {
             cache.advance();
@@ -202,44 +237,30 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
                 for (c, &v) in d.iter().enumerate() {
                     case |= ((v < 0.0) as u8) << c;
                 }
-                if case == 0 || case == 255 {
-                    continue;
-                }
-                let tris: &CellTriangles = match options.topology {
-                    Topology::Fixed => &fixed[case as usize],
-                    Topology::Trilinear => {
-                        &with_faces[(case as usize) << 6 | joined_faces(case, &d) as usize]
-                    }
-                };
-                let mut ids = [NONE; 13];
-                let mut at = 0;
-                for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
-                    let group = &tris.edges[3 * at..3 * (at + count as usize)];
-                    at += count as usize;
-                    for &e in group.iter().filter(|&&e| e != CENTER) {
-                        let e = e as usize;
-                        if ids[e] != NONE {
-                            continue;
-                        }
-                        let slot = cache.slot(i, j, e);
-                        if *slot == NONE {
-                            *slot = mesh.positions.len() as u32;
-                            mesh.positions.push(edge_point(grid, [i, j, k], e, &d));
-                        }
-                        ids[e] = *slot;
-                    }
-                    if group.contains(&CENTER) {
-                        ids[CENTER as usize] = mesh.positions.len() as u32;
-                        mesh.positions.push(polygon_center(&mesh.positions, group, &ids));
-                    }
-                    for t in group.chunks_exact(3) {
-                        mesh.triangles.push([ids[t[0] as usize], ids[t[1] as usize], ids[t[2] as usize]]);
-                    }
+                if case != 0 && case != 255 {
+                    visit([i, j, k], case, &d, &mut cache);
                 }
             }
         }
     }
-    Ok(mesh)
+}
+
+/// The vertex on cell edge `e` of `cell` (values `d`): looked up in the cache, or placed by
+/// [`edge_point`] and appended to `positions` the first time any cell around the edge asks.
+pub(crate) fn edge_vertex(
+    cache: &mut EdgeCache,
+    positions: &mut Vec<Vec3>,
+    grid: &Grid,
+    cell: [usize; 3],
+    e: usize,
+    d: &[f32; 8],
+) -> u32 {
+    let slot = cache.slot(cell[0], cell[1], e);
+    if *slot == NONE {
+        *slot = positions.len() as u32;
+        positions.push(edge_point(grid, cell, e, d));
+    }
+    *slot
 }
 
 /// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.
