@@ -19,6 +19,7 @@ pub mod expr;
 pub mod field;
 pub mod grid;
 pub mod mc;
+pub mod mcq;
 pub mod mesh;
 pub mod pipeline;
 pub mod scenes;

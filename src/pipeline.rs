@@ -7,6 +7,7 @@ use crate::expr::{self, Program};
 use crate::field::{Field, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
+use crate::mcq::{self, McqOptions, PolygonRules};
 use crate::mesh::Mesh;
 use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
@@ -18,15 +19,18 @@ pub enum Method {
     #[default]
     Mc,
     Emc,
+    /// Marching Cubes with the per-cell triangle-quality rules of issue 7 (see [`crate::mcq`]).
+    Mcq,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 2] = ["mc", "emc"];
+    pub const NAMES: [&'static str; 3] = ["mc", "emc", "mcq"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
             "mc" => Ok(Method::Mc),
             "emc" => Ok(Method::Emc),
+            "mcq" => Ok(Method::Mcq),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -39,6 +43,7 @@ impl Method {
         match self {
             Method::Mc => "mc",
             Method::Emc => "emc",
+            Method::Mcq => "mcq",
         }
     }
 }
@@ -61,6 +66,11 @@ pub struct Request {
     pub phi_corner: f32,
     /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
     pub directed: bool,
+    /// MCQ: the per-cell rules, the snapping distance in cells (`None`: no snapping) and whether
+    /// inserted vertices are projected onto the surface.
+    pub mcq_rules: PolygonRules,
+    pub mcq_snap: Option<f32>,
+    pub mcq_project: bool,
 }
 
 impl Default for Request {
@@ -76,6 +86,9 @@ impl Default for Request {
             theta_sharp: 0.9,
             phi_corner: 0.7,
             directed: true,
+            mcq_rules: PolygonRules::default(),
+            mcq_snap: Some(mcq::DEFAULT_SNAP),
+            mcq_project: true,
         }
     }
 }
@@ -83,6 +96,16 @@ impl Default for Request {
 impl Request {
     fn mc_options(&self) -> McOptions {
         McOptions { iso: self.iso, topology: self.topology, max_cells: self.max_cells }
+    }
+
+    fn mcq_options(&self) -> McqOptions {
+        McqOptions {
+            iso: self.iso,
+            max_cells: self.max_cells,
+            rules: self.mcq_rules,
+            snap: self.mcq_snap,
+            project: self.mcq_project,
+        }
     }
 
     fn emc_options(&self) -> EmcOptions {
@@ -157,6 +180,10 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
             let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
+        Method::Mcq => {
+            let (mesh, report) = mcq::mesh_field(field, &grid, &request.mcq_options())?;
+            Meshed::plain(mesh, report.phases())
+        }
     };
     let shifted = Shifted { field, iso: request.iso };
     Ok(meshed.analyse(request.method, request.res, &shifted, request.analysis))
@@ -198,6 +225,10 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
         Method::Emc => {
             let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
+        }
+        Method::Mcq => {
+            let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
+            Meshed::plain(mesh, report.phases())
         }
     };
     let field = SampledField { grid: *grid, values };

@@ -4,6 +4,7 @@
 use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
 use isoforge::grid::{self, Dtype, Grid};
 use isoforge::mc::Topology;
+use isoforge::mcq::PolygonRules;
 use isoforge::mesh::export;
 use isoforge::pipeline::{self, Method, Output, Request};
 use isoforge::stats::AnalysisOptions;
@@ -60,7 +61,8 @@ struct MeshArgs {
     /// Position of the first --grid sample [default: 0,0,0].
     #[arg(long, value_parser = list::<f32, 3>, value_name = "X,Y,Z", allow_hyphen_values = true, conflicts_with_all = NOT_GRID)]
     origin: Option<[f32; 3]>,
-    /// Meshing method: mc (Marching Cubes) or emc (Extended Marching Cubes).
+    /// Meshing method: mc (Marching Cubes), emc (Extended Marching Cubes) or mcq (Marching Cubes
+    /// with per-cell triangle-quality rules).
     #[arg(long, default_value = "mc")]
     method: String,
     /// Cells along the longest side of the bounds (a --grid has its own).
@@ -96,6 +98,18 @@ struct MeshArgs {
     /// EMC: place edge crossings by linear interpolation instead of exact root finding.
     #[arg(long)]
     no_directed: bool,
+    /// MCQ: merge vertices closer than this many cells to a grid point onto it (0: no snapping).
+    #[arg(long, default_value_t = isoforge::mcq::DEFAULT_SNAP)]
+    snap: f32,
+    /// MCQ: cut off polygon corners whose angle is below this many degrees as their own triangle.
+    #[arg(long)]
+    cut_angle: Option<f32>,
+    /// MCQ: give a four-sided polygon an inner vertex when its longest/shortest edge exceeds this.
+    #[arg(long)]
+    quad_ratio: Option<f32>,
+    /// MCQ: leave inserted vertices in their polygon (the paper) instead of projecting them onto the surface.
+    #[arg(long)]
+    no_project: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -133,6 +147,7 @@ fn main() -> ExitCode {
 }
 
 fn mesh(args: MeshArgs) -> Result<(), Error> {
+    let defaults = PolygonRules::default();
     let request = Request {
         method: Method::parse(&args.method)?,
         res: args.res,
@@ -147,6 +162,12 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
+        mcq_rules: PolygonRules {
+            cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
+            quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),
+        },
+        mcq_snap: (args.snap > 0.0).then_some(args.snap),
+        mcq_project: !args.no_project,
     };
     let out = mesh_input(&args, &request)?;
     if let Some(path) = &args.output {
