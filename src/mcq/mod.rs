@@ -49,7 +49,7 @@ impl Default for McqOptions {
 }
 
 /// Default snapping distance in cells (see the README's measurements).
-pub const DEFAULT_SNAP: f32 = 0.2;
+pub const DEFAULT_SNAP: f32 = 0.3;
 
 /// What a run did, besides the mesh.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -132,7 +132,20 @@ fn extract(
 
     let t = Instant::now();
     let snapped = match options.snap {
-        Some(alpha) => snap::snap(&mut positions, &polys, grid, alpha),
+        Some(alpha) => snap::snap(&mut positions, &polys, grid, alpha, |g| {
+            // The merged vertex may move off the grid point onto the surface, but no further than
+            // the vertices it replaces were (so it stays in the cells around the point).
+            if !options.project {
+                return g;
+            }
+            let on = newton(field, options.iso, g);
+            let reach = grid.spacing * alpha;
+            if on.is_finite() && (on - g).abs().cmple(reach).all() {
+                on
+            } else {
+                g
+            }
+        }),
         None => snap::Snapped {
             rep: (0..positions.len() as u32).collect(),
             corner: vec![None; positions.len()],
@@ -181,8 +194,20 @@ fn extract(
     let mut triangles = vec![];
     for (p, border) in &borders {
         let inner = positions.len() as u32;
+        let first = triangles.len();
         if let Some(c) = polygon::triangulate(border, &options.rules, &mut edges, inner, &mut triangles) {
-            let c = if options.project { project(field, options.iso, c, grid, polys[*p].cell) } else { c };
+            let c = if options.project {
+                // On the surface, unless that makes the fan's worst angle worse than in the plane.
+                let on = project(field, options.iso, c, grid, polys[*p].cell);
+                let fan = &triangles[first..];
+                if fan_min_angle(&positions, fan, inner, on) >= fan_min_angle(&positions, fan, inner, c) {
+                    on
+                } else {
+                    c
+                }
+            } else {
+                c
+            };
             positions.push(c);
             report.inserted += 1;
         }
@@ -204,6 +229,18 @@ fn extract(
     Ok((mesh, report))
 }
 
+/// The smallest angle of the triangles around inner vertex `inner` if it sat at `at`.
+fn fan_min_angle(positions: &[Vec3], fan: &[[u32; 3]], inner: u32, at: Vec3) -> f32 {
+    let pos = |v: u32| if v == inner { at } else { positions[v as usize] };
+    fan.iter()
+        .filter(|t| t.contains(&inner))
+        .flat_map(|t| {
+            let p = t.map(pos);
+            (0..3).map(move |a| (p[(a + 1) % 3] - p[a]).angle_between(p[(a + 2) % 3] - p[a]))
+        })
+        .fold(f32::MAX, f32::min)
+}
+
 /// The faces of `cell` that grid point `g` (one of its corners) lies on.
 fn corner_faces(cell: [usize; 3], g: [usize; 3]) -> u8 {
     (0..3).fold(0, |m, a| m | if g[a] == cell[a] { 1 << (2 * a) } else { 1 << (2 * a + 1) })
@@ -214,6 +251,18 @@ fn corner_faces(cell: [usize; 3], g: [usize; 3]) -> u8 {
 fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 3]) -> Vec3 {
     let lo = grid.position(cell[0], cell[1], cell[2]);
     let hi = lo + grid.spacing;
+    let p = newton(field, iso, start);
+    let inside = p.cmpge(lo).all() && p.cmple(hi).all() && p.is_finite();
+    if inside {
+        p
+    } else {
+        start
+    }
+}
+
+/// A few Newton steps from `start` towards `field = iso` along the gradient (`start` when the
+/// field has no usable gradient there).
+fn newton(field: &dyn Field, iso: f32, start: Vec3) -> Vec3 {
     let mut p = start;
     for _ in 0..4 {
         let Some(g) = field.gradient(p) else { return start };
@@ -223,12 +272,7 @@ fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 
         }
         p -= g * ((field.value(p) - iso) / g2);
     }
-    let inside = p.cmpge(lo).all() && p.cmple(hi).all() && p.is_finite();
-    if inside {
-        p
-    } else {
-        start
-    }
+    p
 }
 
 /// Drops vertices no triangle uses (merged ones) and renumbers.

@@ -36,7 +36,15 @@ struct Collapser<'a> {
     rep: Vec<u32>,
 }
 
-pub(super) fn snap(positions: &mut [Vec3], polys: &[CellPolygon], grid: &Grid, alpha: f32) -> Snapped {
+/// `place` says where a merged vertex goes, given its grid point (the grid point itself, or its
+/// projection onto the surface).
+pub(super) fn snap(
+    positions: &mut [Vec3],
+    polys: &[CellPolygon],
+    grid: &Grid,
+    alpha: f32,
+    place: impl Fn(Vec3) -> Vec3,
+) -> Snapped {
     let n = positions.len();
     let mut c = Collapser {
         tris: vec![],
@@ -79,7 +87,7 @@ pub(super) fn snap(positions: &mut [Vec3], polys: &[CellPolygon], grid: &Grid, a
         }
         members.sort_by(|a, b| a.0.total_cmp(&b.0));
         let m = members[0].1;
-        let target = grid.position(g[0], g[1], g[2]);
+        let target = place(grid.position(g[0], g[1], g[2]));
         let mut rest: Vec<u32> = members[1..].iter().map(|x| x.1).collect();
         // A member may only become adjacent to `m` once another has merged: retry until stuck.
         loop {
@@ -118,6 +126,14 @@ impl Collapser<'_> {
         out
     }
 
+    /// Whether `v` lies on the border of an open surface: an edge there has one triangle only.
+    fn on_border(&self, v: u32) -> bool {
+        let mut around: Vec<u32> =
+            self.live(v).flat_map(|t| self.tris[t as usize]).filter(|&x| x != v).collect();
+        around.sort_unstable();
+        around.chunk_by(|a, b| a == b).any(|run| run.len() == 1)
+    }
+
     /// Merges `v` into `m`, moving `m` to `target`, if that keeps everything valid.
     fn try_collapse(&mut self, m: u32, v: u32, target: Vec3) -> bool {
         let shared: Vec<u32> = self.live(v).filter(|&t| self.tris[t as usize].contains(&m)).collect();
@@ -134,6 +150,10 @@ impl Collapser<'_> {
             || nm.len() + nv.len() < 7
             || opposite.iter().any(|&o| self.neighbours(o).len() < 4)
         {
+            return false;
+        }
+        // Two vertices on the open border of a clipped surface would pinch it.
+        if self.on_border(m) && self.on_border(v) {
             return false;
         }
         // No remaining triangle may turn over or collapse.
