@@ -22,8 +22,11 @@ fn start() {
 
 #[wasm_bindgen(typescript_custom_section)]
 const TS_TYPES: &'static str = r#"
-/** Meshing method: Marching Cubes, or Extended Marching Cubes (keeps sharp edges and corners). */
-export type Method = "mc" | "emc";
+/**
+ * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), or
+ * Marching Cubes with per-cell triangle-quality rules and vertex snapping (better angles).
+ */
+export type Method = "mc" | "emc" | "mcq";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
 /** Sample type of a volume given to meshGrid as raw little-endian bytes. */
@@ -56,6 +59,10 @@ export interface MeshOptions {
   phiCorner?: number;
   /** EMC: exact edge crossings by root finding (default true) rather than linear interpolation. */
   directed?: boolean;
+  /** MCQ: merge vertices closer than this many cells to a grid point onto it (default 0.3; 0 turns snapping off). */
+  snap?: number;
+  /** MCQ: project inserted and merged vertices onto the surface (default true; the paper does not). */
+  project?: boolean;
 }
 
 /** Options of meshGrid: the shared ones plus the sample type. */
@@ -134,6 +141,8 @@ struct JsOptions {
     theta_sharp: Option<f32>,
     phi_corner: Option<f32>,
     directed: Option<bool>,
+    snap: Option<f32>,
+    project: Option<bool>,
     dtype: Option<String>,
 }
 
@@ -198,6 +207,13 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>), JsVa
     r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);
     r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
     r.directed = o.directed.unwrap_or(r.directed);
+    match o.snap {
+        None => {}
+        Some(a) if a == 0.0 => r.mcq_snap = None,
+        Some(a) if a.is_finite() && a > 0.0 && a < 0.5 => r.mcq_snap = Some(a),
+        Some(a) => return Err(js_error(Error::InvalidOption(format!("snap must be in [0, 0.5), got {a}")))),
+    }
+    r.mcq_project = o.project.unwrap_or(r.mcq_project);
     let dtype = o.dtype.as_deref().map(Dtype::parse).transpose().map_err(js_error)?;
     Ok((r, dtype))
 }

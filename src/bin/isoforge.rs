@@ -166,7 +166,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
             cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
             quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),
         },
-        mcq_snap: (args.snap > 0.0).then_some(args.snap),
+        mcq_snap: (args.snap != 0.0).then_some(args.snap),
         mcq_project: !args.no_project,
     };
     let out = mesh_input(&args, &request)?;

@@ -113,6 +113,12 @@ fn extract(
     field: &dyn Field,
 ) -> Result<(Mesh, McqReport), Error> {
     check_finite(values, grid)?;
+    if let Some(alpha) = options.snap {
+        // Past half a cell a vertex would be near two grid points at once.
+        if !(alpha > 0.0 && alpha < 0.5) {
+            return Err(Error::InvalidOption(format!("snap must be in (0, 0.5) cells, got {alpha}")));
+        }
+    }
     let mut report = McqReport::default();
     let t = Instant::now();
     let mut positions = vec![];
