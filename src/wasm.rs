@@ -207,11 +207,9 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>), JsVa
     r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);
     r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
     r.directed = o.directed.unwrap_or(r.directed);
-    match o.snap {
-        None => {}
-        Some(a) if a == 0.0 => r.mcq_snap = None,
-        Some(a) if a.is_finite() && a > 0.0 && a < 0.5 => r.mcq_snap = Some(a),
-        Some(a) => return Err(js_error(Error::InvalidOption(format!("snap must be in [0, 0.5), got {a}")))),
+    // 0 turns snapping off; other values are range-checked by the method, like the CLI's --snap.
+    if let Some(a) = o.snap {
+        r.mcq_snap = (a != 0.0).then_some(a);
     }
     r.mcq_project = o.project.unwrap_or(r.mcq_project);
     let dtype = o.dtype.as_deref().map(Dtype::parse).transpose().map_err(js_error)?;
