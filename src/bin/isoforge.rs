@@ -2,6 +2,7 @@
 //! the command line, write OBJ/STL/PLY, print stats as JSON.
 
 use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
+use isoforge::field::SampleGradient;
 use isoforge::grid::{self, Dtype, Grid};
 use isoforge::mc::Topology;
 use isoforge::mcq::PolygonRules;
@@ -110,6 +111,16 @@ struct MeshArgs {
     /// MCQ: leave inserted vertices in their polygon (the paper) instead of projecting them onto the surface.
     #[arg(long)]
     no_project: bool,
+    /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
+    /// central differences at the samples interpolated (continuous across cells) [default: central].
+    #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
+    gradient: Option<GradientArg>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GradientArg {
+    Trilinear,
+    Central,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -168,6 +179,10 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         },
         mcq_snap: (args.snap != 0.0).then_some(args.snap),
         mcq_project: !args.no_project,
+        gradient: match args.gradient {
+            Some(GradientArg::Trilinear) => SampleGradient::Trilinear,
+            Some(GradientArg::Central) | None => SampleGradient::CentralDifferences,
+        },
     };
     let out = mesh_input(&args, &request)?;
     if let Some(path) = &args.output {

@@ -13,7 +13,7 @@ mod snap;
 pub use polygon::PolygonRules;
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_grid, Field, SampledField};
+use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since};
 use crate::mesh::Mesh;
@@ -99,11 +99,12 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McqOptions) -> Resul
     Ok((mesh, report))
 }
 
-/// Meshes an already sampled volume; its trilinear interpolant stands in for the field.
+/// Meshes an already sampled volume; its trilinear interpolant stands in for the field, with its
+/// own gradient (the exact derivative of the values, which is what Newton's projection needs).
 pub fn mesh_samples(values: &[f32], grid: &Grid, options: &McqOptions) -> Result<(Mesh, McqReport), Error> {
     grid.check_size(options.max_cells)?;
     check_finite(values, grid)?;
-    extract(values, grid, options, &SampledField { grid: *grid, values })
+    extract(values, grid, options, &SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear })
 }
 
 fn extract(
