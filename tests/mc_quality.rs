@@ -80,7 +80,10 @@ fn hyperboloid_and_grid_with_holes_lose_most_bad_angles_and_keep_their_topology(
         assert_eq!(t_q.non_manifold_edges + t_q.non_manifold_vertices + t_q.misoriented_edges, 0, "{source}");
         assert_eq!(t_q.degenerate_triangles, 0, "{source}");
         assert_eq!(t_q.euler, t_mc.euler, "{source}");
-        assert_eq!(t_q.boundary_edges, t_mc.boundary_edges, "{source}: the clipped border stays");
+        assert!(
+            t_q.boundary_edges > 0 && t_q.boundary_edges <= t_mc.boundary_edges,
+            "{source}: clipped border"
+        );
         assert_eq!(analysis::self_intersections(&better), 0, "{source}");
         let (s_mc, s_q) = (share_below(&plain, 20), share_below(&better, 20));
         assert!(s_q < 0.25 * s_mc, "{source}: angles below 20°: {s_q:.3} vs MC {s_mc:.3}");
@@ -92,21 +95,32 @@ fn hyperboloid_and_grid_with_holes_lose_most_bad_angles_and_keep_their_topology(
             e_mc.dist_max
         );
     }
+    // Once border vertices may merge too, the grid with holes reaches the sphere's bounds.
+    let (_, better) = both(&expr::compile(GRID_WITH_HOLES).unwrap(), &grid, &McqOptions::default());
+    let angles = analysis::angle_stats(&better);
+    assert!(
+        angles.min_deg >= 20.0 && angles.max_deg <= 130.0,
+        "{:.1}°–{:.1}°",
+        angles.min_deg,
+        angles.max_deg
+    );
 }
 
 #[test]
-fn random_fields_stay_closed_manifold_with_the_euler_characteristic_of_mc() {
+fn random_fields_stay_manifold_with_the_euler_characteristic_of_mc() {
     let mut rng = Rng::new(7);
-    for round in 0..12 {
+    for round in 0..24 {
         let cells = [6 + rng.below(10) as usize, 6 + rng.below(10) as usize, 6 + rng.below(10) as usize];
         let grid = Grid::new(Vec3::ZERO, Vec3::ONE, cells).unwrap();
+        // A union of balls: kept off the border (closed outputs) in even rounds, clipped by it
+        // (open outputs, whose border vertices snap too) in odd ones.
+        let clipped = round % 2 == 1;
+        let (lo, hi, r_max) = if clipped { (0.0, 1.0, 0.4) } else { (0.25, 0.75, 0.25) };
         let blobs: Vec<(Vec3, f32)> = (0..4)
             .map(|_| {
-                let c = Vec3::new(rng.range(0.25, 0.75), rng.range(0.25, 0.75), rng.range(0.25, 0.75));
-                (c, rng.range(0.08, 0.25))
+                (Vec3::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi)), rng.range(0.08, r_max))
             })
             .collect();
-        // A union of balls kept off the border, so every output is closed.
         let f = |p: Vec3| blobs.iter().map(|&(c, r)| p.distance(c) - r).fold(f32::MAX, f32::min);
         let values: Vec<f32> = (0..grid.point_count())
             .map(|i| {
@@ -119,7 +133,15 @@ fn random_fields_stay_closed_manifold_with_the_euler_characteristic_of_mc() {
             let options = McqOptions { snap, ..McqOptions::default() };
             let (better, _) = mcq::mesh_samples(&values, &grid, &options).unwrap();
             let what = format!("round {round}, cells {cells:?}, snap {snap:?}");
-            let topo = assert_watertight(&better, &what);
+            let topo = if clipped {
+                let t = analysis::topology(&better);
+                assert_eq!(t.non_manifold_edges + t.non_manifold_vertices + t.misoriented_edges, 0, "{what}");
+                assert_eq!(t.degenerate_triangles, 0, "{what}");
+                assert_eq!(analysis::self_intersections(&better), 0, "{what}");
+                t
+            } else {
+                assert_watertight(&better, &what)
+            };
             assert_eq!(topo.euler, analysis::topology(&plain).euler, "{what}");
         }
     }

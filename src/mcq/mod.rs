@@ -16,7 +16,7 @@ use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since};
-use crate::mesh::Mesh;
+use crate::mesh::{analysis, Mesh};
 use crate::tables::{edge_faces, polygon_table};
 use glam::Vec3;
 use polygon::{key, Corner};
@@ -139,13 +139,13 @@ fn extract(
 
     let t = Instant::now();
     let snapped = match options.snap {
-        Some(alpha) => snap::snap(&mut positions, &polys, grid, alpha, |g| {
+        Some(alpha) => snap::snap(&mut positions, &polys, grid, alpha, |g, free| {
             // The merged vertex may move off the grid point onto the surface, but no further than
             // the vertices it replaces were (so it stays in the cells around the point).
             if !options.project {
                 return g;
             }
-            let on = newton(field, options.iso, g);
+            let on = newton(field, options.iso, g, free);
             let reach = grid.spacing * alpha;
             if on.is_finite() && (on - g).abs().cmple(reach).all() {
                 on
@@ -160,6 +160,12 @@ fn extract(
         },
     };
     report.merged = snapped.merged;
+    // Where each projected vertex would sit unprojected: a merged vertex on its grid point.
+    let mut unprojected: Vec<Option<Vec3>> = snapped
+        .corner
+        .iter()
+        .map(|g| g.filter(|_| options.project).map(|g| grid.position(g[0], g[1], g[2])))
+        .collect();
     let find = |mut v: u32| {
         while snapped.rep[v as usize] != v {
             v = snapped.rep[v as usize];
@@ -203,7 +209,7 @@ fn extract(
         let inner = positions.len() as u32;
         let first = triangles.len();
         if let Some(c) = polygon::triangulate(border, &options.rules, &mut edges, inner, &mut triangles) {
-            let c = if options.project {
+            let on_surface = if options.project {
                 // On the surface, unless that makes the fan's worst angle worse than in the plane.
                 let on = project(field, options.iso, c, grid, polys[*p].cell);
                 let fan = &triangles[first..];
@@ -215,11 +221,13 @@ fn extract(
             } else {
                 c
             };
-            positions.push(c);
+            unprojected.push((options.project && on_surface != c).then_some(c));
+            positions.push(on_surface);
             report.inserted += 1;
         }
     }
-    let mut mesh = compact(positions, triangles);
+    let mut mesh = compact(positions, triangles, &mut unprojected);
+    unproject_where_crossing(&mut mesh, &unprojected);
     report.triangulate_ms = ms_since(t);
 
     let t = Instant::now();
@@ -258,7 +266,7 @@ fn corner_faces(cell: [usize; 3], g: [usize; 3]) -> u8 {
 fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 3]) -> Vec3 {
     let lo = grid.position(cell[0], cell[1], cell[2]);
     let hi = lo + grid.spacing;
-    let p = newton(field, iso, start);
+    let p = newton(field, iso, start, [true; 3]);
     let inside = p.cmpge(lo).all() && p.cmple(hi).all() && p.is_finite();
     if inside {
         p
@@ -267,12 +275,13 @@ fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 
     }
 }
 
-/// A few Newton steps from `start` towards `field = iso` along the gradient (`start` when the
-/// field has no usable gradient there).
-fn newton(field: &dyn Field, iso: f32, start: Vec3) -> Vec3 {
+/// A few Newton steps from `start` towards `field = iso` along the gradient restricted to the
+/// `free` axes (`start` when the field has no usable gradient there).
+fn newton(field: &dyn Field, iso: f32, start: Vec3, free: [bool; 3]) -> Vec3 {
+    let mask = Vec3::from(free.map(|f| f as u8 as f32));
     let mut p = start;
     for _ in 0..4 {
-        let Some(g) = field.gradient(p) else { return start };
+        let Some(g) = field.gradient(p).map(|g| g * mask) else { return start };
         let g2 = g.length_squared();
         if g2 < 1e-20 {
             return start;
@@ -282,8 +291,31 @@ fn newton(field: &dyn Field, iso: f32, start: Vec3) -> Vec3 {
     p
 }
 
-/// Drops vertices no triangle uses (merged ones) and renumbers.
-fn compact(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
+/// Projection moves a vertex without looking at the triangles around it, which can then cross
+/// another sheet close by: every projected vertex of a crossing triangle pair goes back to where
+/// it was before projection (its grid point, or its polygon's plane), where nothing crossed in
+/// any of our tests, until no pair crosses. Costs one self-intersection pass when nothing crosses.
+fn unproject_where_crossing(mesh: &mut Mesh, unprojected: &[Option<Vec3>]) {
+    loop {
+        let mut moved = false;
+        for pair in analysis::self_intersecting_pairs(mesh) {
+            for t in pair {
+                for v in mesh.triangles[t as usize] {
+                    if let Some(p) = unprojected[v as usize] {
+                        moved |= mesh.positions[v as usize] != p;
+                        mesh.positions[v as usize] = p;
+                    }
+                }
+            }
+        }
+        if !moved {
+            return;
+        }
+    }
+}
+
+/// Drops vertices no triangle uses (merged ones) and renumbers (`extra` per vertex along).
+fn compact(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, extra: &mut Vec<Option<Vec3>>) -> Mesh {
     let mut map = vec![u32::MAX; positions.len()];
     let mut mesh = Mesh::default();
     for t in &triangles {
@@ -295,5 +327,12 @@ fn compact(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
         }
     }
     mesh.triangles = triangles.iter().map(|t| t.map(|v| map[v as usize])).collect();
+    let mut kept = vec![None; mesh.positions.len()];
+    for (old, &new) in map.iter().enumerate() {
+        if new != u32::MAX {
+            kept[new as usize] = extra[old];
+        }
+    }
+    *extra = kept;
     mesh
 }

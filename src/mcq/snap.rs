@@ -36,14 +36,14 @@ struct Collapser<'a> {
     rep: Vec<u32>,
 }
 
-/// `place` says where a merged vertex goes, given its grid point (the grid point itself, or its
-/// projection onto the surface).
+/// `place` says where a merged vertex goes, given its grid point and the axes along which it may
+/// move (the grid point itself, or its projection onto the surface).
 pub(super) fn snap(
     positions: &mut [Vec3],
     polys: &[CellPolygon],
     grid: &Grid,
     alpha: f32,
-    place: impl Fn(Vec3) -> Vec3,
+    place: impl Fn(Vec3, [bool; 3]) -> Vec3,
 ) -> Snapped {
     let n = positions.len();
     let mut c = Collapser {
@@ -87,7 +87,10 @@ pub(super) fn snap(
         }
         members.sort_by(|a, b| a.0.total_cmp(&b.0));
         let m = members[0].1;
-        let target = place(grid.position(g[0], g[1], g[2]));
+        let at = grid.position(g[0], g[1], g[2]);
+        // On the border of a clipped surface, the vertex stays in the domain's faces.
+        let free: [bool; 3] = std::array::from_fn(|a| g[a] > 0 && g[a] < grid.cells[a]);
+        let target = (place(at, [true; 3]), place(at, free));
         let mut rest: Vec<u32> = members[1..].iter().map(|x| x.1).collect();
         // A member may only become adjacent to `m` once another has merged: retry until stuck.
         loop {
@@ -134,26 +137,36 @@ impl Collapser<'_> {
         around.chunk_by(|a, b| a == b).any(|run| run.len() == 1)
     }
 
-    /// Merges `v` into `m`, moving `m` to `target`, if that keeps everything valid.
-    fn try_collapse(&mut self, m: u32, v: u32, target: Vec3) -> bool {
+    /// Merges `v` into `m`, moving `m` to `target.0`, or to `target.1` (which stays in the domain's
+    /// faces) when either is on the border of a clipped surface, if that keeps everything valid.
+    fn try_collapse(&mut self, m: u32, v: u32, target: (Vec3, Vec3)) -> bool {
         let shared: Vec<u32> = self.live(v).filter(|&t| self.tris[t as usize].contains(&m)).collect();
-        if shared.len() != 2 {
+        let (border_m, border_v) = (self.on_border(m), self.on_border(v));
+        // An inner edge joins two border vertices only across the surface: merging them would
+        // pinch it. A border edge (one triangle) may go if its opposite vertex is inside, so
+        // the border just loses a vertex.
+        let valid = match shared.len() {
+            2 => !(border_m && border_v),
+            1 => {
+                let o = self.tris[shared[0] as usize].into_iter().find(|&x| x != m && x != v);
+                o.is_some_and(|o| !self.on_border(o))
+            }
+            _ => false,
+        };
+        if !valid {
             return false;
         }
+        let target = if border_m || border_v { target.1 } else { target.0 };
         let mut opposite: Vec<u32> =
             shared.iter().flat_map(|&t| self.tris[t as usize]).filter(|&x| x != m && x != v).collect();
         opposite.sort_unstable();
         let (nm, nv) = (self.neighbours(m), self.neighbours(v));
         let common: Vec<u32> = nm.iter().copied().filter(|x| nv.contains(x)).collect();
-        // The merged vertex keeps at least three neighbours, and so do the two opposite vertices.
+        // The merged vertex keeps at least three neighbours, and so do the opposite vertices.
         if common != opposite
-            || nm.len() + nv.len() < 7
+            || nm.len() + nv.len() < 5 + shared.len()
             || opposite.iter().any(|&o| self.neighbours(o).len() < 4)
         {
-            return false;
-        }
-        // Two vertices on the open border of a clipped surface would pinch it.
-        if self.on_border(m) && self.on_border(v) {
             return false;
         }
         // No remaining triangle may turn over or collapse.
