@@ -7,6 +7,7 @@
 //!   gradients, interval bounds, batches).
 //! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
+//! - [`mcq`]: Marching Cubes with better triangles (per-cell polygon rules and vertex snapping).
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
