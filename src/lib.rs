@@ -9,6 +9,7 @@
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
 //! - [`emc`]: Extended Marching Cubes (sharp features on the MC grid).
 //! - [`dmc`]: Dual Marching Cubes (an octree adapted to the field, contoured on its dual grid).
+//! - [`mcq`]: Marching Cubes with better triangles (per-cell polygon rules and vertex snapping).
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
 //! - [`input`]: reading triangle meshes (OBJ, STL, PLY, OFF) and oriented point clouds (PLY, XYZ)
 //!   for EMC's remeshing and surface reconstruction ([`emc::mesh_source`], [`emc::point_source`]).
@@ -25,6 +26,7 @@ pub mod field;
 pub mod grid;
 pub mod input;
 pub mod mc;
+pub mod mcq;
 pub mod mesh;
 pub mod pipeline;
 pub mod scenes;

@@ -10,6 +10,7 @@ use crate::expr::{self, Program};
 use crate::field::{BatchFn, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
+use crate::mcq::{self, McqOptions, PolygonRules};
 use crate::mesh::Mesh;
 use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
@@ -25,16 +26,19 @@ pub enum Method {
     Mc,
     Emc,
     Dmc,
+    /// Marching Cubes with the per-cell triangle-quality rules of issue 7 (see [`crate::mcq`]).
+    Mcq,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 3] = ["mc", "emc", "dmc"];
+    pub const NAMES: [&'static str; 4] = ["mc", "emc", "dmc", "mcq"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
             "mc" => Ok(Method::Mc),
             "emc" => Ok(Method::Emc),
             "dmc" => Ok(Method::Dmc),
+            "mcq" => Ok(Method::Mcq),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -48,6 +52,7 @@ impl Method {
             Method::Mc => "mc",
             Method::Emc => "emc",
             Method::Dmc => "dmc",
+            Method::Mcq => "mcq",
         }
     }
 }
@@ -70,6 +75,11 @@ pub struct Request {
     pub phi_corner: f32,
     /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
     pub directed: bool,
+    /// MCQ: the per-cell rules, the snapping distance in cells (`None`: no snapping) and whether
+    /// inserted vertices are projected onto the surface.
+    pub mcq_rules: PolygonRules,
+    pub mcq_snap: Option<f32>,
+    pub mcq_project: bool,
     /// Sampled volumes only: which gradient stands in for the true surface's normals in the
     /// error statistics (see [`SampleGradient`]).
     pub gradient: SampleGradient,
@@ -96,6 +106,9 @@ impl Default for Request {
             theta_sharp: 0.9,
             phi_corner: 0.7,
             directed: true,
+            mcq_rules: PolygonRules::default(),
+            mcq_snap: Some(mcq::DEFAULT_SNAP),
+            mcq_project: true,
             gradient: SampleGradient::default(),
             tolerance: DmcOptions::default().tolerance,
             max_depth: None,
@@ -131,6 +144,16 @@ impl Request {
         match self.method {
             Method::Dmc => 1usize.checked_shl(self.depth() as u32).unwrap_or(usize::MAX),
             _ => self.res,
+        }
+    }
+
+    fn mcq_options(&self) -> McqOptions {
+        McqOptions {
+            iso: self.iso,
+            max_cells: self.max_cells,
+            rules: self.mcq_rules,
+            snap: self.mcq_snap,
+            project: self.mcq_project,
         }
     }
 
@@ -231,6 +254,10 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
             let (mesh, stats) = dmc::mesh_field(field, min, max, &request.dmc_options())?;
             Meshed::from_dmc(mesh, stats)
         }
+        Method::Mcq => {
+            let (mesh, report) = mcq::mesh_field(field, &grid, &request.mcq_options())?;
+            Meshed::plain(mesh, report.phases())
+        }
     };
     let shifted = Shifted { field, iso: request.iso };
     Ok(meshed.analyse(request.method, request.reported_res(), &shifted, request.analysis))
@@ -282,6 +309,10 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
             let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
             Meshed::from_dmc(mesh, stats)
+        }
+        Method::Mcq => {
+            let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
+            Meshed::plain(mesh, report.phases())
         }
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };

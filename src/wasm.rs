@@ -29,10 +29,11 @@ fn start() {
 #[wasm_bindgen(typescript_custom_section)]
 const TS_TYPES: &'static str = r#"
 /**
- * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), or Dual
- * Marching Cubes (adaptive octree: sharp features and thin walls with few triangles).
+ * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), Dual
+ * Marching Cubes (adaptive octree: sharp features and thin walls with few triangles), or Marching
+ * Cubes with per-cell triangle-quality rules and vertex snapping (better angles).
  */
-export type Method = "mc" | "emc" | "dmc";
+export type Method = "mc" | "emc" | "dmc" | "mcq";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
 /** Sample type of a volume given to meshGrid as raw little-endian bytes. */
@@ -73,6 +74,10 @@ export interface MeshOptions {
   maxDepth?: number;
   /** DMC: QEF samples per cell along each axis, 2 to 16 (default 4). */
   samplesPerCell?: number;
+  /** MCQ: merge vertices closer than this many cells to a grid point onto it (default 0.3; 0 turns snapping off). */
+  snap?: number;
+  /** MCQ: project inserted and merged vertices onto the surface (default true; the paper does not). */
+  project?: boolean;
 }
 
 /** Options of meshGrid: the shared ones plus the sample type. */
@@ -192,6 +197,8 @@ struct JsOptions {
     tolerance: Option<f32>,
     max_depth: Option<f64>,
     samples_per_cell: Option<f64>,
+    snap: Option<f32>,
+    project: Option<bool>,
     dtype: Option<String>,
     gradient: Option<String>,
 }
@@ -277,6 +284,11 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool)
     if let Some(n) = o.samples_per_cell {
         r.samples_per_cell = whole("samplesPerCell", n, 1e6)? as usize;
     }
+    // 0 turns snapping off; other values are range-checked by the method, like the CLI's --snap.
+    if let Some(a) = o.snap {
+        r.mcq_snap = (a != 0.0).then_some(a);
+    }
+    r.mcq_project = o.project.unwrap_or(r.mcq_project);
     if let Some(g) = &o.gradient {
         r.gradient = SampleGradient::parse(g).map_err(js_error)?;
     }

@@ -316,3 +316,20 @@ fn malformed_mesh_and_point_files_name_the_file_and_line() {
     let err = fails(&["mesh", "--mesh", bad.to_str().unwrap(), "--scene", "sphere"]);
     assert!(err.contains("cannot be used with"), "{err}");
 }
+
+#[test]
+fn mcq_method_its_options_and_the_angle_histogram_reach_the_json() {
+    let sphere = ["mesh", "--expr", "sphere(0.8)", "--res", "9"];
+    let mc = stats(&[&sphere[..], &["--method", "mc"]].concat());
+    let mcq = stats(&[&sphere[..], &["--method", "mcq"]].concat());
+    let per_cell = stats(&[&sphere[..], &["--method", "mcq", "--snap", "0", "--no-project"]].concat());
+    assert_eq!(mcq["method"], "mcq");
+    assert_eq!(mc["triangles"], 524);
+    assert!(mcq["min_angle_deg"].as_f64().unwrap() >= 20.0, "{mcq}");
+    assert_ne!(per_cell["triangles"], mcq["triangles"], "--snap 0 turns snapping off");
+    let histogram = mcq["angle_histogram_5deg"].as_array().unwrap();
+    assert_eq!(histogram.len(), 36);
+    let angles: u64 = histogram.iter().map(|n| n.as_u64().unwrap()).sum();
+    assert_eq!(angles, 3 * mcq["triangles"].as_u64().unwrap(), "every angle in one bin");
+    assert!(fails(&[&sphere[..], &["--method", "mcq", "--snap", "0.7"]].concat()).contains("snap"));
+}

@@ -5,6 +5,7 @@ use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
 use isoforge::field::SampleGradient;
 use isoforge::grid::{self, Dtype, Grid};
 use isoforge::mc::Topology;
+use isoforge::mcq::PolygonRules;
 use isoforge::mesh::export;
 use isoforge::pipeline::{self, Method, Output, Request};
 use isoforge::stats::AnalysisOptions;
@@ -69,7 +70,8 @@ struct MeshArgs {
     /// Position of the first --grid sample [default: 0,0,0].
     #[arg(long, value_parser = list::<f32, 3>, value_name = "X,Y,Z", allow_hyphen_values = true, conflicts_with_all = NOT_GRID)]
     origin: Option<[f32; 3]>,
-    /// Meshing method: mc (Marching Cubes), emc (Extended Marching Cubes) or dmc (Dual Marching Cubes).
+    /// Meshing method: mc (Marching Cubes), emc (Extended Marching Cubes), dmc (Dual Marching
+    /// Cubes) or mcq (Marching Cubes with per-cell triangle-quality rules).
     #[arg(long, default_value = "mc")]
     method: String,
     /// Cells along the longest side of the bounds (a --grid has its own).
@@ -115,6 +117,18 @@ struct MeshArgs {
     /// DMC: QEF samples per cell along each axis.
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().samples_per_cell)]
     samples_per_cell: usize,
+    /// MCQ: merge vertices closer than this many cells to a grid point onto it (0: no snapping).
+    #[arg(long, default_value_t = isoforge::mcq::DEFAULT_SNAP)]
+    snap: f32,
+    /// MCQ: cut off polygon corners whose angle is below this many degrees as their own triangle.
+    #[arg(long)]
+    cut_angle: Option<f32>,
+    /// MCQ: give a four-sided polygon an inner vertex when its longest/shortest edge exceeds this.
+    #[arg(long)]
+    quad_ratio: Option<f32>,
+    /// MCQ: leave inserted vertices in their polygon (the paper) instead of projecting them onto the surface.
+    #[arg(long)]
+    no_project: bool,
     /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
     /// central differences at the samples interpolated (continuous across cells) [default: central].
     #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
@@ -162,6 +176,7 @@ fn main() -> ExitCode {
 }
 
 fn mesh(args: MeshArgs) -> Result<(), Error> {
+    let defaults = PolygonRules::default();
     let request = Request {
         method: Method::parse(&args.method)?,
         res: args.res,
@@ -176,6 +191,12 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
+        mcq_rules: PolygonRules {
+            cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
+            quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),
+        },
+        mcq_snap: (args.snap != 0.0).then_some(args.snap),
+        mcq_project: !args.no_project,
         gradient: match args.gradient {
             Some(GradientArg::Trilinear) => SampleGradient::Trilinear,
             Some(GradientArg::Central) | None => SampleGradient::CentralDifferences,

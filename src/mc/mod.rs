@@ -185,17 +185,50 @@ impl EdgeCache {
 /// Extracts the `options.iso` level set of a sampled grid.
 pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh, Error> {
     check_finite(values, grid)?;
-    let [nx, ny, _] = grid.points();
-    let [cx, cy, cz] = grid.cells;
     let iso = options.iso;
     let mut mesh = Mesh::default();
-    let mut cache = EdgeCache::new(nx, ny);
     let fixed = triangle_table();
     // The 16 384-entry table is built only when the trilinear option asks for it.
     let with_faces: &[CellTriangles] =
         if options.topology == Topology::Trilinear { triangle_table_with_faces() } else { &[] };
-    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
+    for_each_crossed_cell(values, grid, iso, |ijk, case, d, cache| {
+        let mut cell = Cell { grid, ijk, d, ids: [NONE; 13] };
+        let tris: &CellTriangles = match options.topology {
+            Topology::Fixed => &fixed[case as usize],
+            Topology::Trilinear => {
+                let joined = joined_faces(case, d);
+                let joins = interior::interior_joins(case, joined, d);
+                if !joins.is_empty() && !tunnels_meet(values, grid, iso, ijk, case) {
+                    cell.emit_with_tunnels(case, joined, &joins, cache, &mut mesh);
+                    return;
+                }
+                &with_faces[(case as usize) << 6 | joined as usize]
+            }
+        };
+        let mut at = 0;
+        for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
+            let group = &tris.edges[3 * at..3 * (at + count as usize)];
+            at += count as usize;
+            cell.emit_polygon(group, cache, &mut mesh);
+        }
+    });
+    Ok(mesh)
+}
 
+/// Visits every cell the `iso` level crosses in the sweep order [`EdgeCache`] needs, with the
+/// cell's lowest corner, its case (bit `c` set when corner `c` is inside) and its values minus
+/// `iso`. Methods that build on Marching Cubes' vertices (issue 7's quality method) share it, so
+/// vertices are shared per grid edge exactly as here.
+pub(crate) fn for_each_crossed_cell(
+    values: &[f32],
+    grid: &Grid,
+    iso: f32,
+    mut visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
+) {
+    let [nx, ny, _] = grid.points();
+    let [cx, cy, cz] = grid.cells;
+    let mut cache = EdgeCache::new(nx, ny);
+    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     for k in 0..cz {
         if k > 0 {
             cache.advance();
@@ -208,32 +241,30 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
                 for (c, &v) in d.iter().enumerate() {
                     case |= ((v < 0.0) as u8) << c;
                 }
-                if case == 0 || case == 255 {
-                    continue;
-                }
-                let mut cell = Cell { grid, ijk: [i, j, k], d: &d, ids: [NONE; 13] };
-                let tris: &CellTriangles = match options.topology {
-                    Topology::Fixed => &fixed[case as usize],
-                    Topology::Trilinear => {
-                        let joined = joined_faces(case, &d);
-                        let joins = interior::interior_joins(case, joined, &d);
-                        if !joins.is_empty() && !tunnels_meet(values, grid, iso, [i, j, k], case) {
-                            cell.emit_with_tunnels(case, joined, &joins, &mut cache, &mut mesh);
-                            continue;
-                        }
-                        &with_faces[(case as usize) << 6 | joined as usize]
-                    }
-                };
-                let mut at = 0;
-                for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
-                    let group = &tris.edges[3 * at..3 * (at + count as usize)];
-                    at += count as usize;
-                    cell.emit_polygon(group, &mut cache, &mut mesh);
+                if case != 0 && case != 255 {
+                    visit([i, j, k], case, &d, &mut cache);
                 }
             }
         }
     }
-    Ok(mesh)
+}
+
+/// The vertex on cell edge `e` of `cell` (values `d`): looked up in the cache, or placed by
+/// [`edge_point`] and appended to `positions` the first time any cell around the edge asks.
+pub(crate) fn edge_vertex(
+    cache: &mut EdgeCache,
+    positions: &mut Vec<Vec3>,
+    grid: &Grid,
+    cell: [usize; 3],
+    e: usize,
+    d: &[f32; 8],
+) -> u32 {
+    let slot = cache.slot(cell[0], cell[1], e);
+    if *slot == NONE {
+        *slot = positions.len() as u32;
+        positions.push(edge_point(grid, cell, e, d));
+    }
+    *slot
 }
 
 /// The signed corner values of cell `ijk`, in [`CORNERS`] order.
@@ -289,12 +320,7 @@ impl Cell<'_> {
     fn vertex(&mut self, e: u8, cache: &mut EdgeCache, mesh: &mut Mesh) -> u32 {
         let e = e as usize;
         if self.ids[e] == NONE {
-            let slot = cache.slot(self.ijk[0], self.ijk[1], e);
-            if *slot == NONE {
-                *slot = mesh.positions.len() as u32;
-                mesh.positions.push(edge_point(self.grid, self.ijk, e, self.d));
-            }
-            self.ids[e] = *slot;
+            self.ids[e] = edge_vertex(cache, &mut mesh.positions, self.grid, self.ijk, e, self.d);
         }
         self.ids[e]
     }

@@ -1,7 +1,7 @@
 //! Requests on inputs that are not fields: remeshing a triangle mesh and reconstructing a surface
 //! from an oriented point cloud (EMC's own applications, paper §5.3 and §5.2). `method: "emc"`
 //! gives the directed distances (ray hits, tangent planes); `"mc"` plain Marching Cubes on the same
-//! grid's signed values, the baseline; `"dmc"` the octree over the trilinear interpolant of those
+//! grid's signed values, the baseline (`"mcq"` with better triangles); `"dmc"` the octree over the trilinear interpolant of those
 //! same values.
 //!
 //! Without `bounds` the grid covers the input's bounding box padded by two cells, `res` cells
@@ -16,7 +16,7 @@ use crate::field::{Field, SampleGradient, SampledField};
 use crate::grid::Grid;
 use crate::input::PointCloud;
 use crate::mesh::Mesh;
-use crate::{dmc, mc};
+use crate::{dmc, mc, mcq};
 use glam::Vec3;
 
 /// The request's bounds, or the input's padded by two cells.
@@ -27,6 +27,17 @@ fn input_grid(bounds: (Vec3, Vec3), request: &Request) -> Result<Grid, Error> {
     };
     grid.check_size(request.max_cells)?;
     Ok(grid)
+}
+
+/// Plain MC, or MC with better triangles, on the grid's signed values (sampled in `sample_ms`).
+fn grid_method(values: &[f32], grid: &Grid, request: &Request, sample_ms: f64) -> Result<Meshed, Error> {
+    Ok(if request.method == Method::Mcq {
+        let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
+        Meshed::plain(mesh, mcq::McqReport { sample_ms, ..report }.phases())
+    } else {
+        let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
+        Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+    })
 }
 
 /// DMC over the trilinear interpolant of the same signed values plain MC meshes: the inputs' signs
@@ -62,12 +73,10 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
     let grid = input_grid(bounds, request)?;
     let source = MeshBvh::new(mesh)?;
     let meshed = match request.method {
-        Method::Mc => {
+        Method::Mc | Method::Mcq => {
             let t0 = web_time::Instant::now();
             let values = mesh_source::grid_values(&source, &grid);
-            let sample_ms = mc::ms_since(t0);
-            let (mesh, timings) = mc::mesh_samples(&values, &grid, &request.mc_options())?;
-            Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+            grid_method(&values, &grid, request, mc::ms_since(t0))?
         }
         Method::Emc => {
             let (out, timings) = mesh_source::remesh(mesh, &grid, &request.emc_options())?;
@@ -88,12 +97,10 @@ pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Erro
     let grid = input_grid(cloud.bounds(), request)?;
     let index = PointIndex::new(&cloud)?;
     let meshed = match request.method {
-        Method::Mc => {
+        Method::Mc | Method::Mcq => {
             let t0 = web_time::Instant::now();
             let values = point_source::grid_values(&index, &grid);
-            let sample_ms = mc::ms_since(t0);
-            let (mesh, timings) = mc::mesh_samples(&values, &grid, &request.mc_options())?;
-            Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+            grid_method(&values, &grid, request, mc::ms_since(t0))?
         }
         Method::Emc => {
             let (out, timings) = point_source::reconstruct(&cloud, &grid, &request.emc_options())?;

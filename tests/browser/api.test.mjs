@@ -171,3 +171,20 @@ test('EMC options are passed through and feature edges come back', async () => {
   assert.match(r.errors[1], /unknown method 'dmc'/);
   assert.match(r.errors[2], /unknown field `thetaSharpe`, expected one of .*`thetaSharp`/);
 });
+
+test('mcq meshes through the same options and snapping can be turned off', async () => {
+  const r = await inPage((m) => {
+    const sphere = (o) => m.meshExpr('sphere(0.8)', { res: 9, ...o }).stats;
+    const [mc, mcq, perCell] = [sphere({}), sphere({ method: 'mcq' }), sphere({ method: 'mcq', snap: 0, project: false })];
+    let bad = null;
+    try { sphere({ method: 'mcq', snap: 0.7 }); } catch (e) { bad = e.message; }
+    return { mc: mc.triangles, mcq, perCell: perCell.triangles, bad };
+  });
+  assert.equal(r.mc, 524);
+  assert.equal(r.mcq.method, 'mcq');
+  assert.equal(r.mcq.closed_manifold, true);
+  assert.ok(r.mcq.min_angle_deg >= 20 && r.mcq.max_angle_deg <= 130, JSON.stringify(r.mcq));
+  assert.equal(r.mcq.angle_histogram_5deg.length, 36);
+  assert.notEqual(r.perCell, r.mcq.triangles);
+  assert.match(r.bad, /snap must be in/);
+});
