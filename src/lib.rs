@@ -8,6 +8,7 @@
 //! - [`tables`]: the Marching Cubes cube topology and case tables, generated once from first principles.
 //! - [`mc`]: plain Marching Cubes, the baseline every other method is compared against.
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
+//! - [`quad`]: semi-regular quad meshes from the outside faces of cut cells, with collapses.
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
 //!
@@ -21,6 +22,7 @@ pub mod grid;
 pub mod mc;
 pub mod mesh;
 pub mod pipeline;
+pub mod quad;
 pub mod scenes;
 pub mod stats;
 pub mod tables;
