@@ -8,6 +8,7 @@ use crate::field::{Field, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mesh::Mesh;
+use crate::quad::{self, QuadOptions};
 use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
@@ -18,15 +19,18 @@ pub enum Method {
     #[default]
     Mc,
     Emc,
+    /// Semi-regular quad mesh from the outside faces of cut cells, collapsed and subdivided.
+    Quad,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 2] = ["mc", "emc"];
+    pub const NAMES: [&'static str; 3] = ["mc", "emc", "quad"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
             "mc" => Ok(Method::Mc),
             "emc" => Ok(Method::Emc),
+            "quad" => Ok(Method::Quad),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -39,6 +43,7 @@ impl Method {
         match self {
             Method::Mc => "mc",
             Method::Emc => "emc",
+            Method::Quad => "quad",
         }
     }
 }
@@ -61,6 +66,8 @@ pub struct Request {
     pub phi_corner: f32,
     /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
     pub directed: bool,
+    /// Quad method: relaxation, collapse passes, subdivision steps.
+    pub quad: QuadOptions,
 }
 
 impl Default for Request {
@@ -76,6 +83,7 @@ impl Default for Request {
             theta_sharp: 0.9,
             phi_corner: 0.7,
             directed: true,
+            quad: QuadOptions::default(),
         }
     }
 }
@@ -105,6 +113,9 @@ pub struct Output {
     pub mesh: Mesh,
     /// Feature lines as vertex index pairs.
     pub feature_edges: Vec<[u32; 2]>,
+    /// The quad method's faces (4 vertex indices each, counter-clockwise from outside, indexing
+    /// `mesh.positions`); `mesh.triangles` is their triangulation. Empty for triangle methods.
+    pub quads: Vec<[u32; 4]>,
     pub stats: Stats,
 }
 
@@ -117,11 +128,21 @@ struct Meshed {
     feature_counts: [usize; 3],
     /// Points evaluated and grid points (EMC).
     evaluations: Option<(usize, usize)>,
+    quads: Vec<[u32; 4]>,
+    quad_stages: Vec<quad::QuadStage>,
 }
 
 impl Meshed {
     fn plain(mesh: Mesh, phases: Vec<(String, f64)>) -> Meshed {
-        Meshed { mesh, feature_edges: vec![], phases, feature_counts: [0; 3], evaluations: None }
+        Meshed {
+            mesh,
+            feature_edges: vec![],
+            phases,
+            feature_counts: [0; 3],
+            evaluations: None,
+            quads: vec![],
+            quad_stages: vec![],
+        }
     }
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
@@ -131,7 +152,14 @@ impl Meshed {
             phases: timings.phases(),
             mesh: out.mesh,
             feature_edges: out.feature_edges,
+            quads: vec![],
+            quad_stages: vec![],
         }
+    }
+
+    fn from_quad(out: quad::QuadResult, phases: Vec<(String, f64)>) -> Meshed {
+        let mesh = out.mesh.triangulate();
+        Meshed { quads: out.mesh.quads, quad_stages: out.stages, ..Meshed::plain(mesh, phases) }
     }
 
     fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
@@ -139,7 +167,9 @@ impl Meshed {
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
         stats.points_evaluated = self.evaluations.map(|e| e.0);
         stats.grid_points = self.evaluations.map(|e| e.1);
-        Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
+        stats.quads = self.quads.len();
+        stats.quad_stages = self.quad_stages;
+        Output { mesh: self.mesh, feature_edges: self.feature_edges, quads: self.quads, stats }
     }
 }
 
@@ -156,6 +186,10 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
         Method::Emc => {
             let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
+        }
+        Method::Quad => {
+            let (out, phases) = quad::mesh_field(&Shifted { field, iso: request.iso }, &grid, &request.quad)?;
+            Meshed::from_quad(out, phases)
         }
     };
     let shifted = Shifted { field, iso: request.iso };
@@ -198,6 +232,11 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
         Method::Emc => {
             let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
+        }
+        Method::Quad => {
+            let field = SampledField { grid: *grid, values };
+            let (out, phases) = quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
+            Meshed::from_quad(out, phases)
         }
     };
     let field = SampledField { grid: *grid, values };

@@ -69,6 +69,10 @@ pub struct Stats {
     /// Grid points where the field was evaluated (EMC's crust skips the rest), and the grid's size.
     pub points_evaluated: Option<usize>,
     pub grid_points: Option<usize>,
+    /// Quad faces of the quad method (0 otherwise; `triangles` is then their triangulation).
+    pub quads: usize,
+    /// The quad method's record per stage: valence-four share, aspect ratios, distance.
+    pub quad_stages: Vec<crate::quad::QuadStage>,
 }
 
 impl Stats {

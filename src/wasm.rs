@@ -22,8 +22,11 @@ fn start() {
 
 #[wasm_bindgen(typescript_custom_section)]
 const TS_TYPES: &'static str = r#"
-/** Meshing method: Marching Cubes, or Extended Marching Cubes (keeps sharp edges and corners). */
-export type Method = "mc" | "emc";
+/**
+ * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), or a
+ * semi-regular quad mesh (result also carries `quads`).
+ */
+export type Method = "mc" | "emc" | "quad";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
 /** Sample type of a volume given to meshGrid as raw little-endian bytes. */
@@ -84,6 +87,13 @@ export interface MeshStats {
   ms_analysis: number;
   /** EMC: mesh edges on feature lines, cells with an edge / corner feature, edges flipped (0 for MC). */
   feature_edges: number; edge_features: number; corner_features: number; flips: number;
+  /** Quad method: quad count and, per stage, valence-four share, aspect ratios and vertex distance. */
+  quads: number;
+  quad_stages: {
+    stage: string; vertices: number; quads: number; euler: number; valence4_share: number;
+    irregular: number; operations: number; aspect_mean: number; aspect_max: number;
+    dist_max: number; dist_rms: number;
+  }[];
 }
 
 /** A mesh ready for WebGL / three.js: `positions` and `normals` are xyz triples, `indices` triangles (CCW = outward). */
@@ -93,6 +103,8 @@ export interface MeshResult {
   indices: Uint32Array;
   /** Sharp feature lines found by EMC as pairs of vertex indices (empty for MC): draw with gl.LINES. */
   featureEdges: Uint32Array;
+  /** Quad method: 4 vertex indices per quad (CCW = outward); `indices` triangulates them. Empty otherwise. */
+  quads: Uint32Array;
   stats: MeshStats;
 }
 
@@ -236,6 +248,8 @@ fn to_js(out: &Output) -> Result<JsValue, JsValue> {
     set("indices", &Uint32Array::from(&out.mesh.flat_indices()[..]).into())?;
     let features: Vec<u32> = out.feature_edges.iter().flatten().copied().collect();
     set("featureEdges", &Uint32Array::from(&features[..]).into())?;
+    let quads: Vec<u32> = out.quads.iter().flatten().copied().collect();
+    set("quads", &Uint32Array::from(&quads[..]).into())?;
     let serializer = serde_wasm_bindgen::Serializer::json_compatible();
     set("stats", &out.stats.serialize(&serializer).map_err(js_error)?)?;
     Ok(result.into())

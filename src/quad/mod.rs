@@ -10,6 +10,7 @@ pub mod collapse;
 pub mod extract;
 pub mod local;
 pub mod mesh;
+pub mod obj;
 pub mod project;
 pub mod ring;
 pub mod semilocal;
