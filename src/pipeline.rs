@@ -235,7 +235,8 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
         }
         Method::Quad => {
             let field = SampledField { grid: *grid, values };
-            let (out, phases) = quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
+            let (out, phases) =
+                quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
             Meshed::from_quad(out, phases)
         }
     };

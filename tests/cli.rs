@@ -213,7 +213,17 @@ fn output_files_follow_their_extension() {
 #[test]
 fn quad_method_writes_an_obj_of_quads_matching_its_stats() {
     let path = scratch("sphere_quads.obj");
-    let s = stats(&["mesh", "--scene", "sphere", "--method", "quad", "--res", "16", "-o", path.to_str().unwrap()]);
+    let s = stats(&[
+        "mesh",
+        "--scene",
+        "sphere",
+        "--method",
+        "quad",
+        "--res",
+        "16",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
     assert_eq!(s["method"], "quad");
     let text = std::fs::read_to_string(&path).unwrap();
     let faces: Vec<usize> =

@@ -61,9 +61,9 @@ pub fn extract(values: &[f32], grid: &Grid) -> (QuadMesh, ExtractCounts) {
                     }
                 }
                 twin.resize(faces.len() * 4, u32::MAX);
-                for f in first..faces.len() {
+                for (f, face) in faces.iter().enumerate().skip(first) {
                     for c in 0..4 {
-                        let key = (faces[f][c], faces[f][(c + 1) % 4]);
+                        let key = (face[c], face[(c + 1) % 4]);
                         let h = (f * 4 + c) as u32;
                         // A used key is discarded, so unused keys stay unique (Fig. 2a).
                         match open.remove(&(key.1, key.0)) {
@@ -131,9 +131,7 @@ pub fn extract(values: &[f32], grid: &Grid) -> (QuadMesh, ExtractCounts) {
             }
         })
         .collect();
-    let quads = (0..faces.len())
-        .map(|f| [0, 1, 2, 3].map(|c| corner_vertex[f * 4 + c]))
-        .collect();
+    let quads = (0..faces.len()).map(|f| [0, 1, 2, 3].map(|c| corner_vertex[f * 4 + c])).collect();
     (QuadMesh { positions, quads }, counts)
 }
 

@@ -196,7 +196,8 @@ pub(crate) mod tests {
 
     /// The unit cube as six outward quads: the smallest closed quad mesh.
     pub(crate) fn cube() -> QuadMesh {
-        let positions = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)).collect();
+        let positions =
+            (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)).collect();
         let quads = vec![[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         QuadMesh { positions, quads }
     }

@@ -23,7 +23,7 @@ pub fn project_point(field: &dyn Field, p: Vec3, max_step: f32) -> Vec3 {
         }
         let g = gradient(field, q, h);
         let gg = g.length_squared();
-        if !(gg > 1e-20) || !gg.is_finite() {
+        if gg.is_nan() || gg <= 1e-20 || !gg.is_finite() {
             break;
         }
         let mut step = g * (f / gg);

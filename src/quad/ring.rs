@@ -81,7 +81,8 @@ fn trace(
         }
     }
     let irregular = |v: u32| (v != 4) as i64;
-    let before: i64 = rungs.iter().map(|&(a, b)| irregular(val[a as usize]) + irregular(val[b as usize])).sum();
+    let before: i64 =
+        rungs.iter().map(|&(a, b)| irregular(val[a as usize]) + irregular(val[b as usize])).sum();
     let after: i64 = rungs.iter().map(|&(a, b)| irregular(val[a as usize] + val[b as usize] - 4)).sum();
     Some(Ring { quads: rungs.len(), rungs, removed: before - after })
 }
