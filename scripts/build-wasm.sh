@@ -14,6 +14,9 @@ wasm-bindgen --target web --out-dir pkg "$wasm"
 # No wasm-opt pass: Debian's binaryen (108) predates the reference-types output of current rustc
 # and produces a module that fails at instantiation ("Table.set(): Argument 1 is invalid").
 cp pkg-config/package.json pkg-config/README.md pkg/ 2>/dev/null || true
+# The plain-JavaScript parts, shipped as they are (and so also in www/pkg): the CSG builder
+# ("isoforge/csg"), the worker mesher ("isoforge/mesher") and the three.js helpers ("isoforge/three").
+cp pkg-config/*.js pkg-config/*.d.ts pkg/
 [ -f LICENSE ] && cp LICENSE pkg/
 
 log "copying the package and three.js into www/"

@@ -22,6 +22,9 @@ pub enum Error {
     /// something unknown. `line` and `column` are 1-based (column counts characters); `snippet`
     /// is the whole offending source line, so the message stands alone.
     Parse { message: String, line: usize, column: usize, snippet: String },
+    /// A user-supplied field function (see [`crate::field::BatchFn`]) failed or returned a batch
+    /// of the wrong size.
+    FieldFunction(String),
 }
 
 impl fmt::Display for Error {
@@ -42,6 +45,7 @@ impl fmt::Display for Error {
                 write!(f, "unknown {kind} '{name}'; known: {}", known.join(", "))
             }
             Error::Io(msg) => write!(f, "{msg}"),
+            Error::FieldFunction(msg) => write!(f, "field function: {msg}"),
             Error::Parse { message, line, column, snippet } => {
                 write!(f, "{line}:{column}: {message}\n{snippet}\n")?;
                 // Copy tabs from the line so the caret lands under the same column in a terminal.

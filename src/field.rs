@@ -6,6 +6,7 @@
 use crate::error::Error;
 use crate::grid::Grid;
 use glam::Vec3;
+use std::cell::RefCell;
 
 /// A scalar field over space. Implementations with an analytic gradient override [`Field::gradient`];
 /// the papers' feature detection and our vertex normals are only as good as that gradient.
@@ -50,6 +51,93 @@ impl<V: Fn(Vec3) -> f32, G: Fn(Vec3) -> Vec3> Field for WithGradient<V, G> {
     }
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         Some((self.gradient)(p))
+    }
+}
+
+/// A field computed by a closure over batches of points, for callers whose function is costly to
+/// call (a JavaScript function across the wasm boundary): `f(points, values)` fills `values[i]`
+/// with the value at `points[i]` (both slices have the same length) or fails with a message.
+///
+/// [`BatchFn::sample`] calls it once per z-slab of a grid; the [`Field`] methods call it once per
+/// request (one point for [`Field::value`], the six neighbours for the central-difference
+/// [`Field::gradient`], the whole slice for [`Field::values`]). A failure is remembered: from then
+/// on every value is NaN without calling `f` again, and [`BatchFn::error`] returns the message.
+pub struct BatchFn<F> {
+    f: F,
+    /// Step of the central-difference gradient.
+    pub step: f32,
+    error: RefCell<Option<String>>,
+}
+
+impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> BatchFn<F> {
+    pub fn new(f: F, step: f32) -> Self {
+        BatchFn { f, step, error: RefCell::new(None) }
+    }
+
+    /// The first failure of the closure, if any.
+    pub fn error(&self) -> Option<String> {
+        self.error.borrow().clone()
+    }
+
+    fn call(&self, points: &[Vec3], out: &mut [f32]) {
+        if self.error.borrow().is_none() {
+            match (self.f)(points, out) {
+                Ok(()) => return,
+                Err(e) => *self.error.borrow_mut() = Some(e),
+            }
+        }
+        out.fill(f32::NAN);
+    }
+
+    /// Samples every point of `grid`, x fastest, calling the closure once per z-slab. Fails with
+    /// [`Error::FieldFunction`] if the closure does, or [`Error::NonFiniteSample`] naming the first
+    /// NaN or infinite value it returned.
+    pub fn sample(&self, grid: &Grid) -> Result<Vec<f32>, Error> {
+        let [nx, ny, nz] = grid.points();
+        let slab = nx * ny;
+        let mut values = vec![0.0f32; grid.point_count()];
+        let mut points = vec![Vec3::ZERO; slab];
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    points[j * nx + i] = grid.position(i, j, k);
+                }
+            }
+            let start = grid.index(0, 0, k);
+            self.call(&points, &mut values[start..start + slab]);
+            if let Some(e) = self.error() {
+                return Err(Error::FieldFunction(e));
+            }
+        }
+        check_finite(&values, grid)?;
+        Ok(values)
+    }
+}
+
+impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> Field for BatchFn<F> {
+    fn value(&self, p: Vec3) -> f32 {
+        let mut out = [0.0];
+        self.call(&[p], &mut out);
+        out[0]
+    }
+
+    fn gradient(&self, p: Vec3) -> Option<Vec3> {
+        let h = self.step;
+        let pts = [
+            p + Vec3::X * h,
+            p - Vec3::X * h,
+            p + Vec3::Y * h,
+            p - Vec3::Y * h,
+            p + Vec3::Z * h,
+            p - Vec3::Z * h,
+        ];
+        let mut v = [0.0; 6];
+        self.call(&pts, &mut v);
+        Some(Vec3::new(v[0] - v[1], v[2] - v[3], v[4] - v[5]) / (2.0 * h))
+    }
+
+    fn values(&self, points: &[Vec3], out: &mut [f32]) {
+        self.call(points, out);
     }
 }
 
@@ -108,11 +196,56 @@ pub fn check_finite(values: &[f32], grid: &Grid) -> Result<(), Error> {
     Ok(())
 }
 
+/// Which gradient a [`SampledField`] reports.
+///
+/// The trade-off is the one of the EMC paper (Kobbelt et al. 2001, §4.1): the gradient of the
+/// trilinear interpolant is exactly consistent with the interpolated values, but it is only
+/// piecewise continuous: it jumps across every cell face, so normals computed from it (and the
+/// feature detection that compares them) show the grid's facets. Central differences at the
+/// grid points, blended trilinearly, are continuous everywhere and smoother on curved surfaces
+/// (the paper's recommendation for sampled data), at the price of being slightly inconsistent
+/// with the interpolant and of blurring over two cells, which rounds sharp features a little.
+/// Both are exact on linear fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SampleGradient {
+    /// The gradient of the trilinear interpolant: consistent, discontinuous across cell faces.
+    Trilinear,
+    /// Central differences at the grid points, interpolated trilinearly: continuous (the default).
+    #[default]
+    CentralDifferences,
+}
+
+impl SampleGradient {
+    /// The names used by the CLI's `--gradient` and the JS option `gradient`.
+    pub const NAMES: [&'static str; 2] = ["trilinear", "central"];
+
+    pub fn parse(name: &str) -> Result<SampleGradient, Error> {
+        match name {
+            "trilinear" => Ok(SampleGradient::Trilinear),
+            "central" => Ok(SampleGradient::CentralDifferences),
+            _ => Err(Error::UnknownName {
+                kind: "gradient",
+                name: name.to_string(),
+                known: Self::NAMES.iter().map(|s| s.to_string()).collect(),
+            }),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleGradient::Trilinear => "trilinear",
+            SampleGradient::CentralDifferences => "central",
+        }
+    }
+}
+
 /// A sampled volume (CT/MRI stack, or any precomputed grid) seen as a continuous field through
-/// trilinear interpolation; its gradient is the interpolant's own, so it is consistent with MC.
+/// trilinear interpolation; its gradient is chosen by [`SampledField::gradient`] (see
+/// [`SampleGradient`] for the trade-off).
 pub struct SampledField<'a> {
     pub grid: Grid,
     pub values: &'a [f32],
+    pub gradient: SampleGradient,
 }
 
 impl SampledField<'_> {
@@ -151,6 +284,9 @@ impl Field for SampledField<'_> {
     }
 
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
+        if self.gradient == SampleGradient::CentralDifferences {
+            return Some(crate::mc::sample_gradient(self.values, &self.grid, p));
+        }
         let (b, t) = self.locate(p);
         let v = self.corners(b);
         let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
@@ -170,11 +306,83 @@ mod tests {
         let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [4, 5, 6]).unwrap();
         let f = |p: Vec3| 2.0 * p.x - 3.0 * p.y + 0.5 * p.z + 1.0;
         let values = sample_grid(&f, &grid).unwrap();
-        let s = SampledField { grid, values: &values };
-        for p in [Vec3::new(0.1, 0.2, 0.3), Vec3::new(-0.77, 0.5, 0.99), Vec3::new(0.999, -0.999, 0.0)] {
-            assert!((s.value(p) - f(p)).abs() < 1e-5);
-            assert!((s.gradient(p).unwrap() - Vec3::new(2.0, -3.0, 0.5)).length() < 1e-4);
+        for gradient in [SampleGradient::Trilinear, SampleGradient::CentralDifferences] {
+            let s = SampledField { grid, values: &values, gradient };
+            for p in [Vec3::new(0.1, 0.2, 0.3), Vec3::new(-0.77, 0.5, 0.99), Vec3::new(0.999, -0.999, 0.0)] {
+                assert!((s.value(p) - f(p)).abs() < 1e-5);
+                assert!((s.gradient(p).unwrap() - Vec3::new(2.0, -3.0, 0.5)).length() < 1e-4, "{gradient:?}");
+            }
         }
+    }
+
+    #[test]
+    fn both_gradients_agree_on_linear_fields_everywhere() {
+        let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [7, 7, 7]).unwrap();
+        let f = |p: Vec3| -0.4 * p.x + 1.5 * p.y - 2.0 * p.z;
+        let values = sample_grid(&f, &grid).unwrap();
+        let tri = SampledField { grid, values: &values, gradient: SampleGradient::Trilinear };
+        let cd = SampledField { grid, values: &values, gradient: SampleGradient::CentralDifferences };
+        for i in 0..50 {
+            let t = i as f32 / 49.0;
+            let p = Vec3::new(-0.95 + 1.9 * t, 0.9 - 1.7 * t * t, (7.0 * t).sin() * 0.9);
+            let (a, b) = (tri.gradient(p).unwrap(), cd.gradient(p).unwrap());
+            assert!((a - b).length() < 1e-4, "{p}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn central_differences_are_continuous_across_cell_faces_trilinear_is_not() {
+        // A curved field: the interpolant's gradient jumps at the face x = 0.5 between two cells.
+        let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [4, 4, 4]).unwrap();
+        let f = |p: Vec3| p.x * p.x * p.x + p.y * p.y + 0.3 * p.z;
+        let values = sample_grid(&f, &grid).unwrap();
+        let jump = |gradient| {
+            let s = SampledField { grid, values: &values, gradient };
+            let p = Vec3::new(0.5, 0.2, 0.1);
+            let e = Vec3::new(1e-4, 0.0, 0.0);
+            (s.gradient(p + e).unwrap() - s.gradient(p - e).unwrap()).length()
+        };
+        assert!(jump(SampleGradient::Trilinear) > 0.1, "trilinear jump {}", jump(SampleGradient::Trilinear));
+        assert!(
+            jump(SampleGradient::CentralDifferences) < 1e-2,
+            "central jump {}",
+            jump(SampleGradient::CentralDifferences)
+        );
+    }
+
+    #[test]
+    fn batch_fn_samples_one_slab_per_call_and_reports_failures() {
+        let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [8, 8, 8]).unwrap();
+        let calls = std::cell::Cell::new(0);
+        let sphere = BatchFn::new(
+            |pts: &[Vec3], out: &mut [f32]| {
+                calls.set(calls.get() + 1);
+                for (p, o) in pts.iter().zip(out) {
+                    *o = p.length() - 0.7;
+                }
+                Ok(())
+            },
+            1e-3,
+        );
+        let values = sphere.sample(&grid).unwrap();
+        assert_eq!(calls.get(), 9);
+        assert_eq!(values, sample_grid(&|p: Vec3| p.length() - 0.7, &grid).unwrap());
+        let g = sphere.gradient(Vec3::new(0.3, 0.4, 0.0)).unwrap();
+        assert!((g - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-2, "{g}");
+
+        let failing = BatchFn::new(
+            |pts: &[Vec3], out: &mut [f32]| {
+                if pts[0].z > 0.0 {
+                    return Err("boom".to_string());
+                }
+                out.fill(1.0);
+                Ok(())
+            },
+            1e-3,
+        );
+        let err = failing.sample(&grid).unwrap_err();
+        assert_eq!(err, Error::FieldFunction("boom".into()));
+        assert!(failing.value(Vec3::ZERO).is_nan());
     }
 
     #[test]

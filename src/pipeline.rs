@@ -4,7 +4,7 @@
 use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
 use crate::expr::{self, Program};
-use crate::field::{Field, SampledField};
+use crate::field::{BatchFn, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mesh::Mesh;
@@ -68,6 +68,9 @@ pub struct Request {
     pub directed: bool,
     /// Quad method: relaxation, collapse passes, subdivision steps.
     pub quad: QuadOptions,
+    /// Sampled volumes only: which gradient stands in for the true surface's normals in the
+    /// error statistics (see [`SampleGradient`]).
+    pub gradient: SampleGradient,
 }
 
 impl Default for Request {
@@ -84,6 +87,7 @@ impl Default for Request {
             phi_corner: 0.7,
             directed: true,
             quad: QuadOptions::default(),
+            gradient: SampleGradient::default(),
         }
     }
 }
@@ -222,7 +226,8 @@ pub fn mesh_csg_json(json: &str, request: &Request) -> Result<Output, Error> {
 }
 
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
-/// the samples stands in for the true surface in the error statistics.
+/// the samples stands in for the true surface in the error statistics, its normals given by
+/// `request.gradient` (trilinear or interpolated central differences, see [`SampleGradient`]).
 pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Output, Error> {
     let meshed = match request.method {
         Method::Mc => {
@@ -234,16 +239,31 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             Meshed::from_emc(out, timings)
         }
         Method::Quad => {
-            let field = SampledField { grid: *grid, values };
+            let field = SampledField { grid: *grid, values, gradient: request.gradient };
             let (out, phases) =
                 quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
             Meshed::from_quad(out, phases)
         }
     };
-    let field = SampledField { grid: *grid, values };
+    let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
     let res = grid.cells.iter().copied().max().unwrap_or(0);
     Ok(meshed.analyse(request.method, res, &shifted, request.analysis))
+}
+
+/// Meshes a batch field function (the slow path for functions that are costly to call, such as
+/// JavaScript ones): the closure samples the grid over `bounds` (or the request's) one z-slab per
+/// call, then the samples are meshed like [`mesh_samples`], gradients by central differences.
+pub fn mesh_function<F>(field: &BatchFn<F>, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error>
+where
+    F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>,
+{
+    let (min, max) = request.bounds.unwrap_or(bounds);
+    let grid = Grid::with_resolution(min, max, request.res)?;
+    grid.check_size(request.max_cells)?;
+    let values = field.sample(&grid)?;
+    let request = Request { gradient: SampleGradient::CentralDifferences, ..request.clone() };
+    mesh_samples(&values, &grid, &request)
 }
 
 /// The field minus the iso-level, so "the surface" is always the zero set for the analysis.

@@ -4,6 +4,7 @@
 
 use crate::error::Error;
 use crate::expr::{self, Program};
+use crate::field::{BatchFn, SampleGradient};
 use crate::grid::{self, Dtype, Grid, DEFAULT_MAX_CELLS};
 use crate::mc::Topology;
 use crate::pipeline::{self, Method, Output, Request};
@@ -68,6 +69,28 @@ export interface GridOptions extends MeshOptions {
    * ArrayBuffer of raw little-endian bytes (a .raw file), "f32" and "u16" reinterpret the bytes.
    */
   dtype?: Dtype;
+  /**
+   * The volume's gradient, used for the normals of the surface-error statistics (default
+   * "central"): central differences at the samples interpolated (continuous across cells) or
+   * the trilinear interpolant's own (consistent with it, but it jumps at every cell face).
+   */
+  gradient?: SampleGradientName;
+}
+
+/** Which gradient a sampled volume reports: see GridOptions.gradient. */
+export type SampleGradientName = "trilinear" | "central";
+
+/**
+ * A field given as a JavaScript function for meshFunction: called with a batch of points as xyz
+ * triples (one z-slab of the grid per call, never one point at a time), it returns one value per
+ * point, negative inside.
+ */
+export type BatchFieldFunction = (points: Float32Array) => Float32Array | number[];
+
+/** Nanoseconds per point (per box for `interval`) of each evaluation mode: see measureEvaluator. */
+export interface EvaluatorSpeed {
+  treeWalk: number; value: number; valueGradient: number; batch: number; interval: number;
+  instructions: number;
 }
 
 /** Numbers describing one run; the same keys as the CLI's `--stats` JSON. */
@@ -147,6 +170,7 @@ struct JsOptions {
     phi_corner: Option<f32>,
     directed: Option<bool>,
     dtype: Option<String>,
+    gradient: Option<String>,
 }
 
 fn js_error(e: impl std::fmt::Display) -> JsValue {
@@ -155,14 +179,18 @@ fn js_error(e: impl std::fmt::Display) -> JsValue {
 
 /// Options of every function but meshGrid, which alone takes a `dtype`.
 fn parse_options(options: JsValue) -> Result<Request, JsValue> {
-    let (request, dtype) = parse_grid_options(options)?;
-    match dtype {
-        None => Ok(request),
-        Some(_) => Err(js_error(Error::InvalidOption("dtype is an option of meshGrid only".into()))),
+    let (request, dtype, gradient_given) = parse_grid_options(options)?;
+    if dtype.is_some() {
+        return Err(js_error(Error::InvalidOption("dtype is an option of meshGrid only".into())));
     }
+    if gradient_given {
+        return Err(js_error(Error::InvalidOption("gradient is an option of meshGrid only".into())));
+    }
+    Ok(request)
 }
 
-fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>), JsValue> {
+/// The request, the dtype, and whether a `gradient` was given.
+fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool), JsValue> {
     let o: JsOptions = if options.is_undefined() || options.is_null() {
         JsOptions::default()
     } else {
@@ -210,8 +238,11 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>), JsVa
     r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);
     r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
     r.directed = o.directed.unwrap_or(r.directed);
+    if let Some(g) = &o.gradient {
+        r.gradient = SampleGradient::parse(g).map_err(js_error)?;
+    }
     let dtype = o.dtype.as_deref().map(Dtype::parse).transpose().map_err(js_error)?;
-    Ok((r, dtype))
+    Ok((r, dtype, o.gradient.is_some()))
 }
 
 /// Refuses keys `JsOptions` does not have. serde-wasm-bindgen reads a struct by looking up its
@@ -314,11 +345,63 @@ impl Shape {
         vec![v, g.x, g.y, g.z]
     }
 
+    /// Values at many points at once (`points` = xyz triples): far cheaper per point than
+    /// `value`, which crosses the JavaScript boundary once per call.
+    pub fn values(&self, points: &[f32]) -> Result<Vec<f32>, JsValue> {
+        let points = triples(points)?;
+        let mut out = vec![0.0; points.len()];
+        self.program.eval_many(&points, &mut out);
+        Ok(out)
+    }
+
+    /// `[value, dx, dy, dz]` for each point of `points` (xyz triples), gradients exact.
+    #[wasm_bindgen(js_name = valuesAndGradients)]
+    pub fn values_and_gradients(&self, points: &[f32]) -> Result<Vec<f32>, JsValue> {
+        let points = triples(points)?;
+        let mut out = Vec::with_capacity(points.len() * 4);
+        for p in points {
+            let (v, g) = self.program.eval_grad(p);
+            out.extend_from_slice(&[v, g.x, g.y, g.z]);
+        }
+        Ok(out)
+    }
+
+    /// `[lo, hi]`: conservative bounds of the value over the box between the corners (x0, y0, z0)
+    /// and (x1, y1, z1); the surface cannot be in the box if they do not straddle 0.
+    pub fn bounds(&self, x0: f32, y0: f32, z0: f32, x1: f32, y1: f32, z1: f32) -> Vec<f32> {
+        let (lo, hi) = self.program.eval_interval(Vec3::new(x0, y0, z0), Vec3::new(x1, y1, z1));
+        vec![lo, hi]
+    }
+
     /// Instructions on the compiled tape (after constant folding and sharing repeated parts).
     #[wasm_bindgen(getter, js_name = instructionCount)]
     pub fn instruction_count(&self) -> usize {
         self.program.instruction_count()
     }
+}
+
+/// Points given as a flat array of xyz triples.
+fn triples(points: &[f32]) -> Result<Vec<Vec3>, JsValue> {
+    if points.len() % 3 != 0 {
+        return Err(js_error(Error::InvalidOption(format!(
+            "points must be xyz triples, got {} numbers",
+            points.len()
+        ))));
+    }
+    Ok(points.chunks_exact(3).map(Vec3::from_slice).collect())
+}
+
+/// Times the evaluator on this machine: nanoseconds per point of the reference tree walk, of
+/// `value`, `value + gradient`, 64-point batches, and per box of interval bounds, for `text` over
+/// `count` points, each mode run for at least `minMs` milliseconds (performance.now()). For
+/// benchmarks (`scripts/bench-browser.mjs`); it blocks for about five times `minMs`.
+#[wasm_bindgen(js_name = measureEvaluator, unchecked_return_type = "EvaluatorSpeed")]
+pub fn measure_evaluator(text: &str, count: usize, min_ms: f64) -> Result<JsValue, JsValue> {
+    let performance = js_sys::Reflect::get(&js_sys::global(), &"performance".into())?;
+    let now_fn: js_sys::Function = js_sys::Reflect::get(&performance, &"now".into())?.dyn_into()?;
+    let now = || now_fn.call0(&performance).ok().and_then(|v| v.as_f64()).unwrap_or(0.0);
+    let speed = expr::speed::measure(text, count, min_ms, &now).map_err(js_error)?;
+    serde_wasm_bindgen::to_value(&speed).map_err(|e| js_error(e.to_string()))
 }
 
 /// Compiles a program in the expression language. A malformed program throws an `Error` whose
@@ -438,7 +521,7 @@ pub fn mesh_grid(
     bounds: Vec<f32>,
     #[wasm_bindgen(unchecked_param_type = "GridOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
-    let (request, dtype) = parse_grid_options(options)?;
+    let (request, dtype, _) = parse_grid_options(options)?;
     if dims.len() != 3 || dims.iter().any(|&d| d < 2) {
         return Err(js_error(Error::InvalidGrid(format!(
             "dims must be three point counts, each at least 2, got {dims:?}"
@@ -450,4 +533,58 @@ pub fn mesh_grid(
     grid.check_size(request.max_cells).map_err(js_error)?;
     let samples = grid_samples(&values, dtype, &grid)?;
     to_js(&pipeline::mesh_samples(&samples, &grid, &request).map_err(js_error)?)
+}
+
+/// The message of whatever a JavaScript function threw.
+fn thrown_message(e: &JsValue) -> String {
+    if let Some(err) = e.dyn_ref::<js_sys::Error>() {
+        return String::from(err.message());
+    }
+    if let Some(s) = e.as_string() {
+        return s;
+    }
+    js_sys::JSON::stringify(e).ok().and_then(|s| s.as_string()).unwrap_or_else(|| format!("{e:?}"))
+}
+
+/// Meshes a field given as a JavaScript function, the slow path for shapes the language cannot
+/// express. `fn(points)` gets a Float32Array of xyz triples (one z-slab of the grid per call) and
+/// returns a Float32Array (or array) with one value per point, negative inside. The grid spans
+/// `bounds` = [x0, y0, z0, x1, y1, z1] with `options.res` cells along its longest side; gradients
+/// are central differences of the samples. Throws an `Error` if `fn` throws, returns the wrong
+/// number of values or a non-finite one.
+#[wasm_bindgen(js_name = meshFunction, unchecked_return_type = "MeshResult")]
+pub fn mesh_function(
+    #[wasm_bindgen(unchecked_param_type = "BatchFieldFunction")] f: js_sys::Function,
+    #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
+    bounds: Vec<f32>,
+    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let request = parse_options(options)?;
+    let bounds = parse_bounds(&bounds)?;
+    let batch = BatchFn::new(
+        |points: &[Vec3], out: &mut [f32]| {
+            let flat: Vec<f32> = points.iter().flat_map(|p| p.to_array()).collect();
+            let arg = Float32Array::from(&flat[..]);
+            let result =
+                f.call1(&JsValue::NULL, &arg).map_err(|e| format!("it threw: {}", thrown_message(&e)))?;
+            let values = if let Some(a) = result.dyn_ref::<Float32Array>() {
+                a.to_vec()
+            } else if js_sys::Array::is_array(&result) {
+                Float32Array::new(&result).to_vec()
+            } else {
+                return Err("it must return a Float32Array or an array of numbers".into());
+            };
+            if values.len() != out.len() {
+                return Err(format!(
+                    "it returned {} values for {} points (one value per xyz triple)",
+                    values.len(),
+                    out.len()
+                ));
+            }
+            out.copy_from_slice(&values);
+            Ok(())
+        },
+        1e-3,
+    );
+    to_js(&pipeline::mesh_function(&batch, bounds, &request).map_err(js_error)?)
 }

@@ -2,6 +2,7 @@
 //! the command line, write OBJ/STL/PLY, print stats as JSON.
 
 use clap::{ArgGroup, Parser, Subcommand, ValueEnum};
+use isoforge::field::SampleGradient;
 use isoforge::grid::{self, Dtype, Grid};
 use isoforge::mc::Topology;
 use isoforge::mesh::export;
@@ -97,6 +98,16 @@ struct MeshArgs {
     /// EMC: place edge crossings by linear interpolation instead of exact root finding.
     #[arg(long)]
     no_directed: bool,
+    /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
+    /// central differences at the samples interpolated (continuous across cells) [default: central].
+    #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
+    gradient: Option<GradientArg>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GradientArg {
+    Trilinear,
+    Central,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -148,6 +159,10 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
+        gradient: match args.gradient {
+            Some(GradientArg::Trilinear) => SampleGradient::Trilinear,
+            Some(GradientArg::Central) | None => SampleGradient::CentralDifferences,
+        },
         ..Request::default()
     };
     let out = mesh_input(&args, &request)?;

@@ -353,43 +353,4 @@ mod tests {
         assert_eq!(at("atan2(y, x)", Vec3::ZERO), Vec3::ZERO);
         assert_eq!(at("floor(5 * x)", Vec3::new(0.3, 0.0, 0.0)), Vec3::ZERO);
     }
-
-    /// Not a benchmark harness, just numbers: `cargo test --release --lib speed_report -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn speed_report() {
-        use super::super::{naive::eval_tree, parse};
-        use std::time::Instant;
-        let src = "r = 0.3; s = translate(sphere(r), 0.5, 0, 0);\n\
-                   body = smooth_union(union(s, rotate(s, 0, 0, 1, 120), rotate(s, 0, 0, 1, 240)), torus(0.6, 0.1), 0.1);\n\
-                   subtract(body, rotate(cylinder(0.15, 2), 1, 0, 0, 90))";
-        let program = compile(src).unwrap();
-        let script = parse(src).unwrap();
-        let mut rng = Rng::new(5);
-        let points: Vec<Vec3> = (0..200_000).map(|_| rng.vec3(-1.0, 1.0)).collect();
-        let time = |name: &str, f: &mut dyn FnMut() -> f32| {
-            let t = Instant::now();
-            let checksum = f();
-            let ns = t.elapsed().as_nanos() as f64 / points.len() as f64;
-            println!("{name:>12}: {ns:7.1} ns/point (checksum {checksum})");
-            checksum
-        };
-        println!(
-            "{} instructions, {} slots, {} constants",
-            program.instruction_count(),
-            program.slot_count(),
-            program.constant_count()
-        );
-        let tree = time("tree walk", &mut || points.iter().map(|&p| eval_tree(&script, p)).sum());
-        let point = time("tape, point", &mut || points.iter().map(|&p| program.eval(p)).sum());
-        let grad = time("tape, grad", &mut || points.iter().map(|&p| program.eval_grad(p).0).sum());
-        let mut out = vec![0.0; points.len()];
-        let many = time("tape, x64", &mut || {
-            program.eval_many(&points, &mut out);
-            out.iter().sum()
-        });
-        assert!((tree - point).abs() <= 1e-3 * tree.abs().max(1.0));
-        assert_eq!(point, grad);
-        assert_eq!(point, many);
-    }
 }

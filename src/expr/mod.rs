@@ -44,7 +44,8 @@
 //! `lexer` → `parser` (names resolved; an [`ast`] with spans) → `compile` lowers it to a
 //! hash-consed, constant-folded `graph` with the formulas of `shapes` → `tape` allocates
 //! registers → `eval` and `interval` run it. [`csg`] is the JSON front end onto the same tree;
-//! [`naive`] is the reference tree walk used by tests and benchmarks. Each is one file here.
+//! [`naive`] is the reference tree walk used by tests and benchmarks; [`speed`] times every mode
+//! against it with a clock passed in (so browsers can time themselves). Each is one file here.
 //!
 //! # Evaluation modes
 //! All in `f32`. [`Program::eval`] (a point), [`Program::eval_grad`] (value and exact gradient,
@@ -69,6 +70,7 @@ mod ops;
 mod parser;
 mod program;
 mod shapes;
+pub mod speed;
 mod tape;
 
 #[cfg(test)]

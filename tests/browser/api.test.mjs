@@ -3,46 +3,25 @@
 // the wasm package is built.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { chromium } from 'playwright-core';
+import { serve, launch, packagePage, inPage as runInPage } from '../../scripts/browser.mjs';
 
-const PORT = 9000 + Math.floor(Math.random() * 1000);
-const URL = `http://127.0.0.1:${PORT}/`;
 let server;
 let browser;
 let page;
 
 before(async () => {
-  server = spawn(process.execPath, ['scripts/serve.mjs', 'www', String(PORT)], { stdio: ['ignore', 'pipe', 'inherit'] });
-  await new Promise((resolve, reject) => {
-    server.stdout.once('data', resolve);
-    server.once('exit', (code) => reject(new Error(`server exited with ${code}`)));
-  });
-  browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-  });
-  page = await browser.newPage();
-  // Any page of the origin will do; the package is imported by each test's script.
-  await page.goto(`${URL}style.css`);
-  await page.evaluate(async () => {
-    const m = await import('./pkg/isoforge.js');
-    await m.default();
-  });
+  server = await serve('www');
+  browser = await launch();
+  page = await packagePage(browser, server.url);
 });
 
 after(async () => {
   await browser?.close();
-  server?.kill();
+  server?.close();
 });
 
-/** Runs `body(m)` in the page with the initialised module `m`; returns what it returns (JSON-able). */
-const inPage = (body, arg) => page.evaluate(async ([src, arg]) => {
-  const m = await import('./pkg/isoforge.js');
-  // eslint-disable-next-line no-new-func
-  return new Function('m', 'arg', `return (${src})(m, arg);`)(m, arg);
-}, [body.toString(), arg]);
+/** Runs `body(m, arg)` in the page with the initialised package module `m`. */
+const inPage = (body, arg) => runInPage(page, body, arg);
 
 test('compile returns a reusable shape that meshes at several resolutions', async () => {
   const r = await inPage((m) => {

@@ -2,119 +2,186 @@
 // page served on localhost. Run by scripts/test.sh after the wasm package is built.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { chromium } from 'playwright-core';
+import { serve, launch } from '../../scripts/browser.mjs';
 
-const PORT = 8000 + Math.floor(Math.random() * 1000);
-const URL = `http://127.0.0.1:${PORT}/`;
 let server;
 let browser;
 
 before(async () => {
-  server = spawn(process.execPath, ['scripts/serve.mjs', 'www', String(PORT)], { stdio: ['ignore', 'pipe', 'inherit'] });
-  await new Promise((resolve, reject) => {
-    server.stdout.once('data', resolve);
-    server.once('exit', (code) => reject(new Error(`server exited with ${code}`)));
-  });
-  browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-  });
+  server = await serve('www');
+  browser = await launch();
 });
 
 after(async () => {
   await browser?.close();
-  server?.kill();
+  server?.close();
 });
 
+const LEFT = '.pane[data-side="left"]';
+const RIGHT = '.pane[data-side="right"]';
+
+/** Waits until neither pane is meshing; fails on a pane error unless `allowErrors`. */
+async function settled(page, { allowErrors = false } = {}) {
+  await page.waitForFunction(() => {
+    const panes = [...document.querySelectorAll('.pane')];
+    return panes.length === 2 && panes.every((p) => p.dataset.state === 'done' || p.dataset.state === 'error');
+  }, null, { timeout: 120_000 });
+  if (!allowErrors) {
+    for (const side of [LEFT, RIGHT]) {
+      const state = await page.$eval(side, (p) => [p.dataset.state, p.querySelector('.state').textContent]);
+      assert.equal(state[0], 'done', `${side}: ${state[1]}`);
+    }
+  }
+}
+
 async function openDemo() {
-  const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
   const errors = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  await page.goto(URL);
-  await page.waitForSelector('#status[data-state="done"]', { timeout: 60_000 });
+  await page.goto(server.url);
+  await settled(page);
   return { page, errors };
 }
 
-const stat = (page, key) => page.$eval(`#stats tr[data-key="${key}"] td:last-child`, (td) => td.textContent);
+const stat = (page, side, key) => page.$eval(`${side} .stats tr[data-key="${key}"] td:last-child`, (td) => td.textContent);
+const count = async (page, side, key) => Number((await stat(page, side, key)).replace(/,/g, ''));
 
-test('the demo meshes the default scene and reports a closed manifold', async () => {
+test('both viewports mesh the default scene, EMC and DMC, as closed manifolds with their numbers', async () => {
   const { page, errors } = await openDemo();
-  assert.ok(Number((await stat(page, 'triangles')).replace(/,/g, '')) > 0);
-  assert.equal(await stat(page, 'closed manifold'), 'yes');
-  // The cube minus a ball that pokes through all six faces is a frame of genus 5.
-  assert.equal(await stat(page, 'Euler characteristic'), '-8');
+  assert.equal(await page.$eval(`${LEFT} .method`, (s) => s.value), 'emc');
+  assert.equal(await page.$eval(`${RIGHT} .method`, (s) => s.value), 'dmc');
+  for (const side of [LEFT, RIGHT]) {
+    assert.ok(await count(page, side, 'triangles') > 0);
+    assert.equal(await stat(page, side, 'closed manifold'), 'yes');
+    // The cube minus a ball that pokes through all six faces is a frame of genus 5.
+    assert.equal(await stat(page, side, 'Euler characteristic'), '-8');
+    for (const key of ['max distance', 'RMS distance', 'normal deviation p95 (°)', 'smallest angle (°)', 'meshing (ms)']) {
+      assert.ok(Number.isFinite(await count(page, side, key)), `${side} ${key}`);
+    }
+    assert.ok(await page.$eval(`${side} .histogram`, (c) => Number(c.dataset.bins)) > 3, 'angle histogram drawn');
+  }
+  assert.ok(await count(page, LEFT, 'feature edges') > 0, 'EMC finds the sharp edges');
   assert.deepEqual(errors, []);
   await page.close();
 });
 
-test('choosing another scene re-meshes it with its own topology', async () => {
-  const { page } = await openDemo();
-  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
-  await page.selectOption('#scene', 'torus');
-  await page.waitForSelector('#status[data-state="done"]');
-  assert.equal(await stat(page, 'Euler characteristic'), '0');
-  assert.equal(await stat(page, 'closed manifold'), 'yes');
+test('gallery scenes load into the editor and re-mesh both sides with their own topology', async () => {
+  const { page, errors } = await openDemo();
+  await page.click('#gallery button[data-scene="torus"]');
+  await settled(page);
+  assert.match(await page.inputValue('#source'), /torus/);
+  for (const side of [LEFT, RIGHT]) {
+    assert.equal(await stat(page, side, 'Euler characteristic'), '0');
+    assert.equal(await stat(page, side, 'closed manifold'), 'yes');
+  }
+  await page.click('#gallery button[data-scene="rocket"]');
+  await settled(page);
+  assert.match(await page.inputValue('#source'), /fin/);
+  for (const side of [LEFT, RIGHT]) assert.equal(await stat(page, side, 'Euler characteristic'), '2');
+  assert.deepEqual(errors, []);
   await page.close();
 });
 
-test('the viewport draws the mesh (not a blank canvas)', async () => {
+test('either side can show plain Marching Cubes instead, without feature lines', async () => {
+  const { page } = await openDemo();
+  await page.selectOption(`${RIGHT} .method`, 'mc');
+  await settled(page);
+  assert.equal(await stat(page, RIGHT, 'feature edges'), '0');
+  assert.equal(await stat(page, RIGHT, 'closed manifold'), 'yes');
+  await page.close();
+});
+
+test('the viewports draw the meshes (not blank canvases)', async () => {
   const { page } = await openDemo();
   await page.waitForTimeout(300);
-  const colours = await page.evaluate(() => {
-    const src = document.querySelector('#viewport canvas');
-    const c = document.createElement('canvas');
-    c.width = 64; c.height = 64;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(src, 0, 0, 64, 64);
-    const data = ctx.getImageData(0, 0, 64, 64).data;
-    const seen = new Set();
-    for (let i = 0; i < data.length; i += 4) seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
-    return seen.size;
-  });
-  assert.ok(colours > 8, `only ${colours} distinct colours: the mesh was not drawn`);
+  for (const side of [LEFT, RIGHT]) {
+    const colours = await page.$eval(`${side} canvas`, (src) => {
+      const c = document.createElement('canvas');
+      c.width = 64; c.height = 64;
+      const ctx = c.getContext('2d');
+      ctx.drawImage(src, 0, 0, 64, 64);
+      const data = ctx.getImageData(0, 0, 64, 64).data;
+      const seen = new Set();
+      for (let i = 0; i < data.length; i += 4) seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
+      return seen.size;
+    });
+    assert.ok(colours > 8, `${side}: only ${colours} distinct colours, the mesh was not drawn`);
+  }
   await page.screenshot({ path: 'target/demo-screenshot.png' });
   await page.close();
 });
 
-test('a bad request shows a clear error instead of freezing the tab', async () => {
-  const { page } = await openDemo();
-  await page.fill('#res', '2048');
-  await page.click('#run');
-  await page.waitForSelector('#status[data-state="error"]');
-  const message = await page.textContent('#status');
-  assert.match(message, /larger than the limit/);
-  await page.close();
-});
-
-test('the editor shows the scene program, and an edited program is meshed instead', async () => {
+test('a broken program shows its error inline at its line and column, and nothing is meshed', async () => {
   const { page, errors } = await openDemo();
-  assert.match(await page.inputValue('#source'), /subtract\(box\(0\.6, 0\.6, 0\.6\), sphere\(0\.75\)\)/);
-  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
-  await page.selectOption('#scene', 'rocket');
-  await page.waitForSelector('#status[data-state="done"]');
-  assert.match(await page.inputValue('#source'), /rotate\(fin, 0, 0, 1, 82\)/);
-  await page.fill('#source', '// a ring\ntorus(0.5, 0.2)');
-  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
-  await page.click('#run');
-  await page.waitForSelector('#status[data-state="done"]');
-  assert.equal(await stat(page, 'Euler characteristic'), '0');
+  const before = await count(page, LEFT, 'triangles');
   await page.fill('#source', 'union(sphere(0.5),\n  bx(1, 1, 1))');
+  await page.waitForSelector('#editor-error:not([hidden])');
+  assert.match(await page.textContent('#editor-error'), /^2:3: unknown function 'bx'/);
+  assert.equal(await page.$eval('#editor-error', (e) => e.dataset.line), '2');
+  assert.equal(await page.$eval('#editor-error', (e) => e.dataset.column), '3');
+  // The box sits below the second line of text, not the first.
+  const [boxTop, areaTop, lineHeight] = await page.evaluate(() => {
+    const area = document.querySelector('#source');
+    return [document.querySelector('#editor-error').getBoundingClientRect().top, area.getBoundingClientRect().top,
+      parseFloat(getComputedStyle(area).lineHeight)];
+  });
+  assert.ok(boxTop - areaTop > 1.5 * lineHeight && boxTop - areaTop < 3.5 * lineHeight, `${boxTop - areaTop} vs ${lineHeight}`);
   await page.click('#run');
-  await page.waitForSelector('#status[data-state="error"]');
-  assert.match(await page.textContent('#status'), /^2:3: unknown function 'bx'/);
+  assert.equal(await page.$eval('#status', (s) => s.dataset.state), 'error');
+  assert.equal(await count(page, LEFT, 'triangles'), before);
+  await page.fill('#source', 'torus(0.5, 0.2)');
+  await page.waitForSelector('#editor-error', { state: 'hidden' });
+  await page.click('#run');
+  await settled(page);
+  assert.equal(await stat(page, LEFT, 'Euler characteristic'), '0');
   assert.deepEqual(errors, []);
   await page.close();
 });
 
-test('EMC draws feature lines', async () => {
-  const { page } = await openDemo();
-  await page.evaluate(() => { document.querySelector('#status').dataset.state = 'pending'; });
-  await page.selectOption('#method', 'emc');
+test('the page answers clicks while a large mesh is computed, and a new request cancels it', async () => {
+  const { page, errors } = await openDemo();
+  await page.fill('#res', '256');
   await page.click('#run');
-  await page.waitForSelector('#status[data-state="done"]');
-  assert.ok(Number((await stat(page, 'feature edges')).replace(/,/g, '')) > 0);
-  assert.equal(await stat(page, 'closed manifold'), 'yes');
+  assert.equal(await page.$eval(LEFT, (p) => p.dataset.state), 'busy');
+  // The click is handled while the left side is still meshing: the main thread is free.
+  await page.click('#wireframe');
+  assert.equal(await page.isChecked('#wireframe'), true);
+  assert.equal(await page.$eval(LEFT, (p) => p.dataset.state), 'busy');
+  assert.equal(await page.$eval(`${LEFT} .busy`, (b) => b.hidden), false, 'progress shown');
+  await page.fill('#res', '24');
+  await page.click('#gallery button[data-scene="sphere"]');
+  await settled(page);
+  assert.equal(await stat(page, LEFT, 'Euler characteristic'), '2');
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a too-large request gets a clear message, not a dead tab', async () => {
+  const { page } = await openDemo();
+  await page.fill('#res', '2048');
+  await page.click('#run');
+  await settled(page, { allowErrors: true });
+  assert.equal(await page.$eval(LEFT, (p) => p.dataset.state), 'error');
+  assert.match(await page.textContent(`${LEFT} .state`), /larger than the limit/);
+  await page.close();
+});
+
+test('the current mesh downloads as OBJ, STL, PLY and GLB', async () => {
+  const { page } = await openDemo();
+  const triangles = await count(page, LEFT, 'triangles');
+  const sizes = {};
+  for (const format of ['obj', 'stl', 'ply', 'glb']) {
+    await page.selectOption(`${LEFT} .format`, format);
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click(`${LEFT} .download`)]);
+    assert.equal(download.suggestedFilename(), `isoforge-emc.${format}`);
+    const chunks = [];
+    for await (const chunk of await download.createReadStream()) chunks.push(chunk);
+    const bytes = Buffer.concat(chunks);
+    sizes[format] = bytes.length;
+    if (format === 'glb') assert.equal(bytes.toString('latin1', 0, 4), 'glTF');
+    if (format === 'stl') assert.equal(bytes.readUInt32LE(80), triangles);
+    if (format === 'obj') assert.equal(bytes.toString().split('\n').filter((l) => l.startsWith('f ')).length, triangles);
+    if (format === 'ply') assert.match(bytes.toString('latin1', 0, 200), new RegExp(`element face ${triangles}`));
+  }
   await page.close();
 });
