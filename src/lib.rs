@@ -13,6 +13,7 @@
 //! - [`mesh`]: the triangle mesh, its analysis (topology, quality, error) and export.
 //! - [`input`]: reading triangle meshes (OBJ, STL, PLY, OFF) and oriented point clouds (PLY, XYZ)
 //!   for EMC's remeshing and surface reconstruction ([`emc::mesh_source`], [`emc::point_source`]).
+//! - [`quad`]: semi-regular quad meshes from the outside faces of cut cells, with collapses.
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
 //!
@@ -29,6 +30,7 @@ pub mod mc;
 pub mod mcq;
 pub mod mesh;
 pub mod pipeline;
+pub mod quad;
 pub mod scenes;
 pub mod stats;
 pub mod tables;

@@ -12,6 +12,7 @@ use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mcq::{self, McqOptions, PolygonRules};
 use crate::mesh::Mesh;
+use crate::quad::{self, QuadOptions};
 use crate::scenes;
 use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
@@ -28,10 +29,12 @@ pub enum Method {
     Dmc,
     /// Marching Cubes with the per-cell triangle-quality rules of issue 7 (see [`crate::mcq`]).
     Mcq,
+    /// Semi-regular quad mesh from the outside faces of cut cells, collapsed and subdivided.
+    Quad,
 }
 
 impl Method {
-    pub const NAMES: [&'static str; 4] = ["mc", "emc", "dmc", "mcq"];
+    pub const NAMES: [&'static str; 5] = ["mc", "emc", "dmc", "mcq", "quad"];
 
     pub fn parse(name: &str) -> Result<Method, Error> {
         match name {
@@ -39,6 +42,7 @@ impl Method {
             "emc" => Ok(Method::Emc),
             "dmc" => Ok(Method::Dmc),
             "mcq" => Ok(Method::Mcq),
+            "quad" => Ok(Method::Quad),
             _ => Err(Error::UnknownName {
                 kind: "method",
                 name: name.to_string(),
@@ -53,6 +57,7 @@ impl Method {
             Method::Emc => "emc",
             Method::Dmc => "dmc",
             Method::Mcq => "mcq",
+            Method::Quad => "quad",
         }
     }
 }
@@ -80,6 +85,8 @@ pub struct Request {
     pub mcq_rules: PolygonRules,
     pub mcq_snap: Option<f32>,
     pub mcq_project: bool,
+    /// Quad method: relaxation, collapse passes, subdivision steps.
+    pub quad: QuadOptions,
     /// Sampled volumes only: which gradient stands in for the true surface's normals in the
     /// error statistics (see [`SampleGradient`]).
     pub gradient: SampleGradient,
@@ -109,6 +116,7 @@ impl Default for Request {
             mcq_rules: PolygonRules::default(),
             mcq_snap: Some(mcq::DEFAULT_SNAP),
             mcq_project: true,
+            quad: QuadOptions::default(),
             gradient: SampleGradient::default(),
             tolerance: DmcOptions::default().tolerance,
             max_depth: None,
@@ -177,6 +185,9 @@ pub struct Output {
     pub mesh: Mesh,
     /// Feature lines as vertex index pairs.
     pub feature_edges: Vec<[u32; 2]>,
+    /// The quad method's faces (4 vertex indices each, counter-clockwise from outside, indexing
+    /// `mesh.positions`); `mesh.triangles` is their triangulation. Empty for triangle methods.
+    pub quads: Vec<[u32; 4]>,
     pub stats: Stats,
 }
 
@@ -191,6 +202,8 @@ struct Meshed {
     evaluations: Option<(usize, usize)>,
     /// Octree leaves and dual cells (DMC).
     octree: Option<(usize, usize)>,
+    quads: Vec<[u32; 4]>,
+    quad_stages: Vec<quad::QuadStage>,
 }
 
 impl Meshed {
@@ -201,6 +214,8 @@ impl Meshed {
             phases,
             feature_counts: [0; 3],
             evaluations: None,
+            quads: vec![],
+            quad_stages: vec![],
             octree: None,
         }
     }
@@ -220,7 +235,14 @@ impl Meshed {
             phases: timings.phases(),
             mesh: out.mesh,
             feature_edges: out.feature_edges,
+            quads: vec![],
+            quad_stages: vec![],
         }
+    }
+
+    fn from_quad(out: quad::QuadResult, phases: Vec<(String, f64)>) -> Meshed {
+        let mesh = out.mesh.triangulate();
+        Meshed { quads: out.mesh.quads, quad_stages: out.stages, ..Meshed::plain(mesh, phases) }
     }
 
     fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
@@ -230,7 +252,9 @@ impl Meshed {
         stats.grid_points = self.evaluations.map(|e| e.1);
         stats.octree_leaves = self.octree.map(|o| o.0);
         stats.dual_cells = self.octree.map(|o| o.1);
-        Output { mesh: self.mesh, feature_edges: self.feature_edges, stats }
+        stats.quads = self.quads.len();
+        stats.quad_stages = self.quad_stages;
+        Output { mesh: self.mesh, feature_edges: self.feature_edges, quads: self.quads, stats }
     }
 }
 
@@ -257,6 +281,10 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
         Method::Mcq => {
             let (mesh, report) = mcq::mesh_field(field, &grid, &request.mcq_options())?;
             Meshed::plain(mesh, report.phases())
+        }
+        Method::Quad => {
+            let (out, phases) = quad::mesh_field(&Shifted { field, iso: request.iso }, &grid, &request.quad)?;
+            Meshed::from_quad(out, phases)
         }
     };
     let shifted = Shifted { field, iso: request.iso };
@@ -313,6 +341,12 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
         Method::Mcq => {
             let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
             Meshed::plain(mesh, report.phases())
+        }
+        Method::Quad => {
+            let field = SampledField { grid: *grid, values, gradient: request.gradient };
+            let (out, phases) =
+                quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
+            Meshed::from_quad(out, phases)
         }
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };

@@ -72,6 +72,10 @@ pub struct Stats {
     /// Leaves of the final octree, and dual cells traversed (DMC).
     pub octree_leaves: Option<usize>,
     pub dual_cells: Option<usize>,
+    /// Quad faces of the quad method (0 otherwise; `triangles` is then their triangulation).
+    pub quads: usize,
+    /// The quad method's record per stage: valence-four share, aspect ratios, distance.
+    pub quad_stages: Vec<crate::quad::QuadStage>,
 }
 
 impl Stats {

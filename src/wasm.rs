@@ -30,10 +30,11 @@ fn start() {
 const TS_TYPES: &'static str = r#"
 /**
  * Meshing method: Marching Cubes, Extended Marching Cubes (keeps sharp edges and corners), Dual
- * Marching Cubes (adaptive octree: sharp features and thin walls with few triangles), or Marching
- * Cubes with per-cell triangle-quality rules and vertex snapping (better angles).
+ * Marching Cubes (adaptive octree: sharp features and thin walls with few triangles), Marching
+ * Cubes with per-cell triangle-quality rules and vertex snapping (better angles), or a
+ * semi-regular quad mesh (result also carries `quads`).
  */
-export type Method = "mc" | "emc" | "dmc" | "mcq";
+export type Method = "mc" | "emc" | "dmc" | "mcq" | "quad";
 /** How ambiguous cell faces are resolved: a fixed rule (fastest) or the trilinear interpolant's. */
 export type Topology = "fixed" | "trilinear";
 /** Sample type of a volume given to meshGrid as raw little-endian bytes. */
@@ -132,6 +133,13 @@ export interface MeshStats {
   points_evaluated: number | null; grid_points: number | null;
   /** DMC: leaves of the final octree and dual cells traversed (null for other methods). */
   octree_leaves: number | null; dual_cells: number | null;
+  /** Quad method: quad count and, per stage, valence-four share, aspect ratios and vertex distance. */
+  quads: number;
+  quad_stages: {
+    stage: string; vertices: number; quads: number; euler: number; valence4_share: number;
+    irregular: number; operations: number; aspect_mean: number; aspect_max: number;
+    dist_max: number; dist_rms: number;
+  }[];
 }
 
 /**
@@ -153,6 +161,8 @@ export interface MeshResult {
   indices: Uint32Array;
   /** Sharp feature lines found by EMC as pairs of vertex indices (empty for MC): draw with gl.LINES. */
   featureEdges: Uint32Array;
+  /** Quad method: 4 vertex indices per quad (CCW = outward); `indices` triangulates them. Empty otherwise. */
+  quads: Uint32Array;
   stats: MeshStats;
 }
 
@@ -330,6 +340,8 @@ fn to_js(out: &Output) -> Result<JsValue, JsValue> {
     set("indices", &Uint32Array::from(&out.mesh.flat_indices()[..]).into())?;
     let features: Vec<u32> = out.feature_edges.iter().flatten().copied().collect();
     set("featureEdges", &Uint32Array::from(&features[..]).into())?;
+    let quads: Vec<u32> = out.quads.iter().flatten().copied().collect();
+    set("quads", &Uint32Array::from(&quads[..]).into())?;
     let serializer = serde_wasm_bindgen::Serializer::json_compatible();
     set("stats", &out.stats.serialize(&serializer).map_err(js_error)?)?;
     Ok(result.into())

@@ -333,3 +333,28 @@ fn mcq_method_its_options_and_the_angle_histogram_reach_the_json() {
     assert_eq!(angles, 3 * mcq["triangles"].as_u64().unwrap(), "every angle in one bin");
     assert!(fails(&[&sphere[..], &["--method", "mcq", "--snap", "0.7"]].concat()).contains("snap"));
 }
+
+#[test]
+fn quad_method_writes_an_obj_of_quads_matching_its_stats() {
+    let path = scratch("sphere_quads.obj");
+    let s = stats(&[
+        "mesh",
+        "--scene",
+        "sphere",
+        "--method",
+        "quad",
+        "--res",
+        "16",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(s["method"], "quad");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let faces: Vec<usize> =
+        text.lines().filter_map(|l| l.strip_prefix("f ")).map(|l| l.split_whitespace().count()).collect();
+    assert!(faces.iter().all(|&n| n == 4), "every face a quad");
+    assert_eq!(faces.len() as u64, s["quads"].as_u64().unwrap());
+    assert_eq!(s["triangles"].as_u64().unwrap(), 2 * s["quads"].as_u64().unwrap());
+    assert_eq!(s["euler"], 2);
+    assert!(s["quad_stages"].as_array().unwrap().len() >= 4);
+}

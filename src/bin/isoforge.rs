@@ -71,7 +71,8 @@ struct MeshArgs {
     #[arg(long, value_parser = list::<f32, 3>, value_name = "X,Y,Z", allow_hyphen_values = true, conflicts_with_all = NOT_GRID)]
     origin: Option<[f32; 3]>,
     /// Meshing method: mc (Marching Cubes), emc (Extended Marching Cubes), dmc (Dual Marching
-    /// Cubes) or mcq (Marching Cubes with per-cell triangle-quality rules).
+    /// Cubes), mcq (Marching Cubes with per-cell triangle-quality rules) or quad (semi-regular
+    /// quads; an .obj output keeps the quads).
     #[arg(long, default_value = "mc")]
     method: String,
     /// Cells along the longest side of the bounds (a --grid has its own).
@@ -204,10 +205,16 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         tolerance: args.tol,
         max_depth: args.max_depth,
         samples_per_cell: args.samples_per_cell,
+        ..Request::default()
     };
     let out = mesh_input(&args, &request)?;
     if let Some(path) = &args.output {
-        export::write_by_extension(&out.mesh, path)?;
+        let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+        if is_obj && request.method == Method::Quad {
+            isoforge::quad::obj::write_obj_file(&out.mesh.positions, &out.quads, path)?;
+        } else {
+            export::write_by_extension(&out.mesh, path)?;
+        }
     }
     if args.stats {
         println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Io(e.to_string()))?);

@@ -1,7 +1,7 @@
 //! Requests on inputs that are not fields: remeshing a triangle mesh and reconstructing a surface
 //! from an oriented point cloud (EMC's own applications, paper §5.3 and §5.2). `method: "emc"`
 //! gives the directed distances (ray hits, tangent planes); `"mc"` plain Marching Cubes on the same
-//! grid's signed values, the baseline (`"mcq"` with better triangles); `"dmc"` the octree over the trilinear interpolant of those
+//! grid's signed values, the baseline (`"mcq"` with better triangles, `"quad"` quads); `"dmc"` the octree over the trilinear interpolant of those
 //! same values.
 //!
 //! Without `bounds` the grid covers the input's bounding box padded by two cells, `res` cells
@@ -16,7 +16,7 @@ use crate::field::{Field, SampleGradient, SampledField};
 use crate::grid::Grid;
 use crate::input::PointCloud;
 use crate::mesh::Mesh;
-use crate::{dmc, mc, mcq};
+use crate::{dmc, mc, mcq, quad};
 use glam::Vec3;
 
 /// The request's bounds, or the input's padded by two cells.
@@ -48,6 +48,13 @@ fn dmc_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Mesh
     let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
     let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
     Ok(Meshed::from_dmc(mesh, stats))
+}
+
+/// The quad method over the trilinear interpolant of the same signed values, on the same grid.
+fn quad_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Meshed, Error> {
+    let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
+    let (out, phases) = quad::mesh_field(&field, grid, &request.quad)?;
+    Ok(Meshed::from_quad(out, phases))
 }
 
 /// Grid methods report the grid's cells along its longest side; DMC its finest octree level.
@@ -83,6 +90,7 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
             Meshed::from_emc(out, timings)
         }
         Method::Dmc => dmc_on_samples(&mesh_source::grid_values(&source, &grid), &grid, request)?,
+        Method::Quad => quad_on_samples(&mesh_source::grid_values(&source, &grid), &grid, request)?,
     };
     let res = reported_res(&grid, request);
     Ok(meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis))
@@ -107,6 +115,7 @@ pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Erro
             Meshed::from_emc(out, timings)
         }
         Method::Dmc => dmc_on_samples(&point_source::grid_values(&index, &grid), &grid, request)?,
+        Method::Quad => quad_on_samples(&point_source::grid_values(&index, &grid), &grid, request)?,
     };
     let res = reported_res(&grid, request);
     Ok(meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis))

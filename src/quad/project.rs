@@ -1,0 +1,85 @@
+//! Putting vertices on the surface: Newton steps along the gradient onto f = 0, and the
+//! relaxation (tangential smoothing, then re-projection) that evens out the octree's staircase.
+
+use super::mesh::QuadMesh;
+use crate::field::{finite_difference_gradient, Field};
+use glam::Vec3;
+
+/// Gradient of the field, exact where it knows one, else central differences with step `h`.
+fn gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
+    field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h))
+}
+
+/// Moves `p` onto f = 0 by Newton steps along the gradient. Each step is capped at `max_step`
+/// (a cell) so a vertex near a saddle or a crease cannot be thrown across the model; the
+/// original point is kept when the field gives no usable gradient.
+pub fn project_point(field: &dyn Field, p: Vec3, max_step: f32) -> Vec3 {
+    let mut q = p;
+    let h = max_step * 1e-3;
+    for _ in 0..20 {
+        let f = field.value(q);
+        if f.abs() <= max_step * 1e-5 {
+            break;
+        }
+        let g = gradient(field, q, h);
+        let gg = g.length_squared();
+        if gg.is_nan() || gg <= 1e-20 || !gg.is_finite() {
+            break;
+        }
+        let mut step = g * (f / gg);
+        let len = step.length();
+        if len > max_step {
+            step *= max_step / len;
+        }
+        q -= step;
+    }
+    if q.is_finite() {
+        q
+    } else {
+        p
+    }
+}
+
+/// Projects every vertex (or those `only` selects) onto the surface.
+pub fn project(mesh: &mut QuadMesh, field: &dyn Field, max_step: f32, only: Option<&[bool]>) {
+    for (v, p) in mesh.positions.iter_mut().enumerate() {
+        if only.is_none_or(|o| o[v]) {
+            *p = project_point(field, *p, max_step);
+        }
+    }
+}
+
+/// `iterations` rounds of: move each vertex part way to the centroid of its neighbours, within
+/// the tangent plane (the normal component would only be undone by the projection), then
+/// project back onto f = 0. Vertex order does not matter: each round reads the previous one.
+pub fn relax(mesh: &mut QuadMesh, field: &dyn Field, iterations: usize, max_step: f32) {
+    let nb = mesh.neighbours();
+    let h = max_step * 1e-3;
+    for _ in 0..iterations {
+        let old = mesh.positions.clone();
+        for (v, p) in mesh.positions.iter_mut().enumerate() {
+            if nb[v].is_empty() {
+                continue;
+            }
+            let centroid = nb[v].iter().map(|&u| old[u as usize]).sum::<Vec3>() / nb[v].len() as f32;
+            let d = centroid - old[v];
+            let n = gradient(field, old[v], h).normalize_or_zero();
+            let tangential = d - n * d.dot(n);
+            *p = project_point(field, old[v] + tangential * 0.5, max_step);
+        }
+    }
+}
+
+/// Largest distance from a vertex to the surface, estimated as |f| / |∇f| (exact for a signed
+/// distance field), and the root mean square of the same.
+pub fn vertex_distance(mesh: &QuadMesh, field: &dyn Field, h: f32) -> (f64, f64) {
+    let mut max: f64 = 0.0;
+    let mut sum = 0.0;
+    for &p in &mesh.positions {
+        let g = gradient(field, p, h).length().max(1e-12);
+        let d = (field.value(p) / g).abs() as f64;
+        max = max.max(d);
+        sum += d * d;
+    }
+    (max, (sum / mesh.positions.len().max(1) as f64).sqrt())
+}
