@@ -15,7 +15,7 @@ use isoforge::{expr, Field, Grid, Mesh, Vec3};
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 fn dmc_mesh(field: &dyn Field, min: Vec3, max: Vec3, options: &DmcOptions) -> (Mesh, dmc::DmcStats) {
     dmc::mesh_field(field, min, max, options).unwrap()

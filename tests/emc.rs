@@ -13,7 +13,7 @@ use isoforge::{expr, Field, Grid, Vec3};
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 const CUBE_MINUS_SPHERE: &str = "max(box(.6, .6, .6), .75 - length(x, y, z))";
 const ROTATED_BOX: &str = "rotate(rotate(box(.5, .35, .25), 1, 0, 0, 23), 0, 1, 1, 31)";

@@ -8,7 +8,7 @@ use isoforge::Mesh;
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 /// The EMC rocket (sharp fins, normals at every vertex) at a resolution that meshes quickly.
 fn rocket() -> Mesh {

@@ -12,7 +12,7 @@ use isoforge::{scenes, Error, Grid, Vec3};
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 const TOPOLOGIES: [Topology; 2] = [Topology::Fixed, Topology::Trilinear];
 

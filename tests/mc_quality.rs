@@ -14,7 +14,7 @@ use isoforge::{expr, Grid, Mesh, Vec3};
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 /// The paper's hyperboloid and "grid" (constants not given in the paper; see the README).
 const HYPERBOLOID: &str = "x*x + y*y - z*z - 0.25";

@@ -12,7 +12,7 @@ use isoforge::{scenes, Grid, Vec3};
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
-wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 /// Scenes whose features are thinner than a cell at the resolutions tested here: Marching Cubes
 /// is not expected to find their topology (that is what they are for), only to stay closed.

@@ -97,7 +97,7 @@ export class Pane {
     this.normals = normals;
     this.applyToggles();
     this.root.querySelector('.stats').replaceChildren(...statsRows(result.stats));
-    drawHistogram(this.root.querySelector('.histogram'), result.stats.angle_histogram);
+    drawHistogram(this.root.querySelector('.histogram'), result.stats.angle_histogram_5deg);
     this.root.querySelector('.download').disabled = false;
   }
 
