@@ -19,7 +19,9 @@ const ROWS = [
 
 /** Table rows (`tr[data-key=label]`) for `stats`, then one per meshing phase. */
 export function statsRows(stats) {
-  const rows = ROWS.filter(([, key]) => key in stats).map(([label, key]) => [label, stats[key]]);
+  // Quads are counted (0) for every method; only the quad mesher has any.
+  const shown = ([, key]) => key in stats && !(key === 'quads' && stats.quads === 0);
+  const rows = ROWS.filter(shown).map(([label, key]) => [label, stats[key]]);
   for (const [phase, ms] of Object.entries(stats.phases_ms ?? {})) rows.push([`  ${phase} (ms)`, ms]);
   return rows.map(([label, value]) => {
     const tr = document.createElement('tr');

@@ -64,7 +64,7 @@ export class Pane {
   async mesh(text, options) {
     this.mesher.cancel();
     const started = performance.now();
-    const busy = this.root.querySelector('.busy');
+    const busy = this.root.querySelector('.progress');
     busy.hidden = false;
     const tick = setInterval(() => {
       busy.querySelector('.elapsed').textContent = `${((performance.now() - started) / 1000).toFixed(1)} s`;

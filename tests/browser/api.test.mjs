@@ -152,7 +152,7 @@ test('EMC options are passed through and feature edges come back', async () => {
   const r = await inPage((m) => {
     const emc = m.meshScene('rotated_box', { method: 'emc', res: 24, thetaSharp: 0.9, phiCorner: 0.7, directed: true });
     const errors = [];
-    for (const o of [{ method: 'emc', thetaSharp: 2 }, { method: 'dmc' }, { thetaSharpe: 0.5 }]) {
+    for (const o of [{ method: 'emc', thetaSharp: 2 }, { method: 'dc' }, { thetaSharpe: 0.5 }]) {
       try { m.meshScene('sphere', { res: 8, ...o }); errors.push(null); } catch (e) { errors.push(e.message); }
     }
     const f = emc.featureEdges;
@@ -168,7 +168,7 @@ test('EMC options are passed through and feature edges come back', async () => {
   assert.ok(r.pairs > 0 && r.even && r.inRange);
   assert.equal(r.pairs, r.counted);
   assert.match(r.errors[0], /thetaSharp/);
-  assert.match(r.errors[1], /unknown method 'dmc'/);
+  assert.match(r.errors[1], /unknown method 'dc'/);
   assert.match(r.errors[2], /unknown field `thetaSharpe`, expected one of .*`thetaSharp`/);
 });
 
