@@ -259,4 +259,3 @@ mod wasm_api {
         assert!(message.contains("every point needs a normal"), "{message}");
     }
 }
-
