@@ -80,6 +80,9 @@ pub struct Request {
     pub phi_corner: f32,
     /// EMC: exact edge crossings by root finding (directed distances) rather than interpolation.
     pub directed: bool,
+    /// EMC: triangulate components without a feature point by MCQ's per-cell rules
+    /// (`mcq_rules`) instead of MC's table.
+    pub better_triangles: bool,
     /// MCQ: the per-cell rules, the snapping distance in cells (`None`: no snapping) and whether
     /// inserted vertices are projected onto the surface.
     pub mcq_rules: PolygonRules,
@@ -113,6 +116,7 @@ impl Default for Request {
             theta_sharp: 0.9,
             phi_corner: 0.7,
             directed: true,
+            better_triangles: false,
             mcq_rules: PolygonRules::default(),
             mcq_snap: Some(mcq::DEFAULT_SNAP),
             mcq_project: true,
@@ -173,6 +177,7 @@ impl Request {
             directed: self.directed,
             flip_edges: true,
             crust: true,
+            better_triangles: self.better_triangles.then_some(self.mcq_rules),
             topology: self.topology,
             max_cells: self.max_cells,
         }

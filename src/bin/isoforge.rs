@@ -108,6 +108,10 @@ struct MeshArgs {
     /// EMC: place edge crossings by linear interpolation instead of exact root finding.
     #[arg(long)]
     no_directed: bool,
+    /// EMC: triangulate cells without a sharp feature by MCQ's per-cell polygon rules (--cut-angle,
+    /// --quad-ratio) instead of Marching Cubes' table; feature fans stay as they are.
+    #[arg(long)]
+    better_triangles: bool,
     /// DMC: error tolerance as a fraction of the bounds' longest side (QEF residual and triangle
     /// distance to the surface).
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().tolerance)]
@@ -192,6 +196,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
+        better_triangles: args.better_triangles,
         mcq_rules: PolygonRules {
             cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
             quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),

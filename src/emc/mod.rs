@@ -21,6 +21,8 @@ use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{joined_faces, ms_since, polygon_center, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mcq::polygon::triangulate_cell_polygon;
+use crate::mcq::PolygonRules;
 use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
 use crate::tables::{
@@ -48,6 +50,11 @@ pub struct EmcOptions {
     /// Evaluate the field only where its interval bounds say the surface may be (§2's crust);
     /// the output is identical. Fields without interval bounds are sampled everywhere.
     pub crust: bool,
+    /// Triangulate the components without a feature point by the per-cell polygon rules of
+    /// [`crate::mcq`] (cut off sharp corners, inner vertex in long or uneven polygons, otherwise
+    /// split the largest angle) instead of MC's table; `None` (default) keeps MC's triangles.
+    /// Feature fans are unchanged. No vertex snapping (see the README).
+    pub better_triangles: Option<PolygonRules>,
 }
 
 impl Default for EmcOptions {
@@ -61,6 +68,7 @@ impl Default for EmcOptions {
             topology: Topology::Fixed,
             max_cells: DEFAULT_MAX_CELLS,
             crust: true,
+            better_triangles: None,
         }
     }
 }
@@ -288,15 +296,16 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                             None => out.rejected_features += 1,
                         }
                     }
-                    plans.push(Plan { by_edge, ids, pts, nrm, group, feature });
+                    plans.push(Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature });
                 }
                 // Pass 2: where a cell holds several components (sheets close together), a fan
                 // that would cut another component's triangles falls back to MC.
                 for a in 0..plans.len() {
                     if plans.len() > 1 && plans[a].feature.is_some() {
-                        let fan = plans[a].triangles(&out.mesh.positions, triangles);
+                        let rules = options.better_triangles.as_ref();
+                        let fan = plans[a].triangles(&out.mesh.positions, triangles, rules);
                         let cuts = (0..plans.len()).filter(|&b| b != a).any(|b| {
-                            let other = plans[b].triangles(&out.mesh.positions, triangles);
+                            let other = plans[b].triangles(&out.mesh.positions, triangles, rules);
                             fan.iter().any(|t| other.iter().any(|u| triangles_intersect(t, u)))
                         });
                         if cuts {
@@ -308,21 +317,16 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                 // Pass 3: emit.
                 for plan in plans {
                     let Some((f, kind)) = plan.feature else {
-                        let mut by_edge = plan.by_edge;
-                        let group = &triangles.edges[3 * plan.group.start..3 * plan.group.end];
-                        if group.contains(&CENTER) {
-                            by_edge[CENTER as usize] = out.mesh.positions.len() as u32;
-                            out.mesh.positions.push(polygon_center(&out.mesh.positions, group, &by_edge));
+                        let (tris, extra) =
+                            plan.plain(&out.mesh.positions, triangles, options.better_triangles.as_ref());
+                        let extra_id = out.mesh.positions.len() as u32;
+                        if let Some(c) = extra {
+                            out.mesh.positions.push(c);
                             normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
                         }
-                        for t in group.chunks_exact(3) {
-                            out.mesh.triangles.push([
-                                by_edge[t[0] as usize],
-                                by_edge[t[1] as usize],
-                                by_edge[t[2] as usize],
-                            ]);
-                        }
+                        let id = |v: u32| if v == EXTRA { extra_id } else { v };
+                        out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
                         continue;
                     };
                     let fid = out.mesh.positions.len() as u32;
@@ -346,42 +350,63 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
 }
 
 /// What one component of a cell will become: its polygon and, where sharp, its feature point.
-struct Plan {
+struct Plan<'a> {
     by_edge: [u32; 13],
     /// The polygon's vertex ids and positions, in order.
     ids: Vec<u32>,
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
+    /// The cell edges its vertices sit on, in the same order.
+    cell_edges: &'a [u8],
     /// Its triangles in the cell's MC triangulation (triangle indices).
     group: std::ops::Range<usize>,
     feature: Option<(Vec3, FeatureKind)>,
 }
 
-impl Plan {
-    /// The triangles this component would emit, as positions (fan or MC triangulation).
-    fn triangles(&self, positions: &[Vec3], table: &CellTriangles) -> Vec<[DVec3; 3]> {
+/// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
+/// the inner vertex of the per-cell rules) before it has an id.
+const EXTRA: u32 = u32::MAX;
+
+impl Plan<'_> {
+    /// The triangles this component would emit, as positions (fan, or as [`Plan::plain`]).
+    fn triangles(
+        &self,
+        positions: &[Vec3],
+        table: &CellTriangles,
+        rules: Option<&PolygonRules>,
+    ) -> Vec<[DVec3; 3]> {
         let n = self.pts.len();
         match self.feature {
             Some((f, _)) => {
                 (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
             }
             None => {
-                let group = &table.edges[3 * self.group.start..3 * self.group.end];
-                let center = self.pts.iter().sum::<Vec3>() / n as f32;
-                group
-                    .chunks_exact(3)
-                    .map(|t| {
-                        [t[0], t[1], t[2]].map(|e| {
-                            if e == CENTER {
-                                center.as_dvec3()
-                            } else {
-                                positions[self.by_edge[e as usize] as usize].as_dvec3()
-                            }
-                        })
-                    })
-                    .collect()
+                let (tris, extra) = self.plain(positions, table, rules);
+                let at = |v: u32| match (v, extra) {
+                    (EXTRA, Some(c)) => c.as_dvec3(),
+                    _ => positions[v as usize].as_dvec3(),
+                };
+                tris.iter().map(|t| t.map(at)).collect()
             }
         }
+    }
+
+    /// The triangles of the component without a feature point, by vertex id ([`EXTRA`] for an
+    /// added vertex, whose position comes along): MC's table, or with `rules` the per-cell polygon
+    /// rules of [`crate::mcq`].
+    fn plain(
+        &self,
+        positions: &[Vec3],
+        table: &CellTriangles,
+        rules: Option<&PolygonRules>,
+    ) -> (Vec<[u32; 3]>, Option<Vec3>) {
+        if let Some(rules) = rules {
+            return triangulate_cell_polygon(&self.ids, &self.pts, self.cell_edges, rules, EXTRA);
+        }
+        let group = &table.edges[3 * self.group.start..3 * self.group.end];
+        let extra = group.contains(&CENTER).then(|| polygon_center(positions, group, &self.by_edge));
+        let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
+        (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
     }
 }
 

@@ -7,7 +7,7 @@
 //! Always uses the default (fixed) case table: its polygons need no centre vertex, so the Marching
 //! Cubes triangulation the snapping step validates its merges on is made of grid-edge vertices only.
 
-mod polygon;
+pub(crate) mod polygon;
 mod snap;
 
 pub use polygon::PolygonRules;
@@ -17,7 +17,7 @@ use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledFiel
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since};
 use crate::mesh::{analysis, Mesh};
-use crate::tables::{edge_faces, polygon_table};
+use crate::tables::polygon_table;
 use glam::Vec3;
 use polygon::{key, Corner};
 use std::collections::HashSet;
@@ -188,7 +188,7 @@ fn extract(
                 }
                 let faces = match snapped.corner[id as usize] {
                     Some(g) => corner_faces(poly.cell, g),
-                    None => edge_faces(e as usize).iter().fold(0, |m, &f| m | 1 << f),
+                    None => Corner::on_edge(id, positions[id as usize], e as usize).faces,
                 };
                 border.push(Corner { id, pos: positions[id as usize], faces });
             }

@@ -8,16 +8,24 @@
 //! two triangles once snapping has merged vertices. When no allowed diagonal is left, the polygon
 //! gets an inner vertex, which needs none.
 
+use crate::tables::edge_faces;
 use glam::Vec3;
 use std::collections::HashSet;
 
 /// One corner of a polygon border: its vertex id, position and the cell faces it lies on (bit `f`
 /// for face `f` of [`crate::tables::FACES`]).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Corner {
+pub(crate) struct Corner {
     pub id: u32,
     pub pos: Vec3,
     pub faces: u8,
+}
+
+impl Corner {
+    /// A corner on cell edge `e` (it lies on that edge's two cell faces).
+    pub(crate) fn on_edge(id: u32, pos: Vec3, e: usize) -> Corner {
+        Corner { id, pos, faces: edge_faces(e).iter().fold(0, |m, &f| m | 1 << f) }
+    }
 }
 
 /// The thresholds of the paper's three decisions.
@@ -36,13 +44,13 @@ impl Default for PolygonRules {
 }
 
 /// An undirected edge key.
-pub(super) fn key(a: u32, b: u32) -> (u32, u32) {
+pub(crate) fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
 /// Triangles of one polygon (outward orientation kept: every triangle follows the border's order).
 /// `inner` is the id an inserted vertex gets; the inserted vertex's position comes back with them.
-pub(super) fn triangulate(
+pub(crate) fn triangulate(
     border: &[Corner],
     rules: &PolygonRules,
     edges: &mut HashSet<(u32, u32)>,
@@ -96,6 +104,30 @@ pub(super) fn triangulate(
         out.push([inner, poly[i].id, poly[(i + 1) % n].id]);
     }
     Some(attracted_center(&poly))
+}
+
+/// One cell polygon of plain (unsnapped) Marching Cubes vertices, triangulated by the rules on its
+/// own: `ids`, `pts` and the cell edges `cell_edges` they sit on, in border order. Returns the
+/// triangles (`inner` standing for the inserted vertex) and the inserted vertex's position.
+///
+/// No edge set shared across polygons is needed here: a diagonal only joins two vertices on no
+/// common face of the cell, that is on two opposite edges of it, and no other cell holds both, so
+/// only the polygon's own border and diagonals can be in the way. (With snapping, merged vertices
+/// break this, which is why [`super::extract`] shares one set over all polygons.)
+pub(crate) fn triangulate_cell_polygon(
+    ids: &[u32],
+    pts: &[Vec3],
+    cell_edges: &[u8],
+    rules: &PolygonRules,
+    inner: u32,
+) -> (Vec<[u32; 3]>, Option<Vec3>) {
+    let border: Vec<Corner> =
+        (0..ids.len()).map(|k| Corner::on_edge(ids[k], pts[k], cell_edges[k] as usize)).collect();
+    let mut edges: HashSet<(u32, u32)> =
+        (0..ids.len()).map(|k| key(ids[k], ids[(k + 1) % ids.len()])).collect();
+    let mut out = Vec::with_capacity(ids.len());
+    let inserted = triangulate(&border, rules, &mut edges, inner, &mut out);
+    (out, inserted)
 }
 
 /// The inner vertex: every border vertex weighted by √(1 + SLME/LSE), where LSE is the shorter of
