@@ -16,20 +16,9 @@ const BLOB: &str = "r = 0.3; s = translate(sphere(r), 0.5, 0, 0);\n\
     body = smooth_union(union(s, rotate(s, 0, 0, 1, 120), rotate(s, 0, 0, 1, 240)), torus(0.6, 0.1), 0.1);\n\
     subtract(body, rotate(cylinder(0.15, 2), 1, 0, 0, 90))";
 
-fn points(n: usize) -> Vec<Vec3> {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-    };
-    (0..n).map(|_| Vec3::new(next(), next(), next())).collect()
-}
-
 fn evaluator(c: &mut Criterion) {
     let rocket = scenes::source("rocket").expect("rocket scene");
-    let pts = points(4096);
+    let pts = expr::speed::points(4096);
     for (name, text) in [("blob", BLOB), ("rocket", rocket)] {
         let program = expr::compile(text).expect("compiles");
         let script = expr::parse(text).expect("parses");

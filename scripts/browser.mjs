@@ -44,3 +44,44 @@ export const inPage = (page, body, arg) => page.evaluate(async ([src, arg]) => {
   // eslint-disable-next-line no-new-func
   return new Function('m', 'arg', `return (${src})(m, arg);`)(m, arg);
 }, [body.toString(), arg]);
+
+/**
+ * For a node:test file whose tests all run in one package page: registers `before`/`after` hooks
+ * that serve www/, launch Chromium and open the page, and returns `inPage(body, arg)` for it.
+ */
+export function sharedPackagePage({ before, after }) {
+  let server;
+  let browser;
+  let page;
+  before(async () => {
+    server = await serve('www');
+    browser = await launch();
+    page = await packagePage(browser, server.url);
+  });
+  after(async () => {
+    await browser?.close();
+    server?.close();
+  });
+  return (body, arg) => inPage(page, body, arg);
+}
+
+/**
+ * What the canvas at `selector` shows, downscaled to `width`×`height`: the number of distinct
+ * colours (12-bit) and the share of pixels that are not near-white. A blank canvas has one colour.
+ */
+export function canvasColours(page, selector, width = 64, height = 48) {
+  return page.$eval(selector, (src, [w, h]) => {
+    const c = document.createElement('canvas');
+    c.width = w; c.height = h;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(src, 0, 0, w, h);
+    const data = ctx.getImageData(0, 0, w, h).data;
+    const seen = new Set();
+    let nonWhite = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
+      if (data[i] + data[i + 1] + data[i + 2] < 3 * 250) nonWhite++;
+    }
+    return { colours: seen.size, covered: nonWhite / (w * h) };
+  }, [width, height]);
+}

@@ -321,6 +321,30 @@ pub fn mesh_csg_json(json: &str, request: &Request) -> Result<Output, Error> {
     mesh_program(&Program::from_csg_json(json)?, request)
 }
 
+/// DMC over the trilinear interpolant of sampled values, sampled like any other field (the QEF
+/// needs values between the samples); the octree's finest level is the grid's.
+fn dmc_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Meshed, Error> {
+    crate::field::check_finite(values, grid)?;
+    let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
+    let (mesh, stats) =
+        dmc::mesh_field(&field, grid.origin, grid.max(), &dmc_request_on(grid, request).dmc_options())?;
+    Ok(Meshed::from_dmc(mesh, stats))
+}
+
+/// The request DMC runs on samples over `grid`: its default depth is the grid's own resolution.
+fn dmc_request_on(grid: &Grid, request: &Request) -> Request {
+    Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() }
+}
+
+/// The `res` reported for samples over `grid`: its cells along the longest side, or for DMC its
+/// finest octree level.
+fn sampled_res(grid: &Grid, request: &Request) -> usize {
+    match request.method {
+        Method::Dmc => dmc_request_on(grid, request).reported_res(),
+        _ => grid.cells.iter().copied().max().unwrap_or(0),
+    }
+}
+
 /// Meshes a sampled volume (`values` x fastest over `grid`'s points). The trilinear interpolant of
 /// the samples stands in for the true surface in the error statistics, its normals given by
 /// `request.gradient` (trilinear or interpolated central differences, see [`SampleGradient`]).
@@ -334,15 +358,7 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             let (out, timings) = emc::mesh_samples(values, grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
-        // DMC samples the trilinear interpolant like any other field (the QEF needs values
-        // between the samples); its depth defaults to the volume's own resolution.
-        Method::Dmc => {
-            crate::field::check_finite(values, grid)?;
-            let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
-            let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
-            let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
-            Meshed::from_dmc(mesh, stats)
-        }
+        Method::Dmc => dmc_on_samples(values, grid, request)?,
         Method::Mcq => {
             let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
             Meshed::plain(mesh, report.phases())
@@ -356,13 +372,7 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
-    let res = match request.method {
-        Method::Dmc => {
-            Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() }.reported_res()
-        }
-        _ => grid.cells.iter().copied().max().unwrap_or(0),
-    };
-    Ok(meshed.analyse(request.method, res, &shifted, request.analysis))
+    Ok(meshed.analyse(request.method, sampled_res(grid, request), &shifted, request.analysis))
 }
 
 /// Meshes a batch field function (the slow path for functions that are costly to call, such as

@@ -101,17 +101,27 @@ impl PointIndex {
                 best = (d, mid as u32);
                 prune = limit(d);
             }
-            let axis = self.axes[mid] as usize;
-            let offset = p[axis] - self.positions[mid][axis];
-            let (near, far) =
-                if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
-            // The far side lies beyond the splitting plane.
-            let mut far_gap = gap;
-            far_gap[axis] = far_gap[axis].max(offset.abs());
-            stack.push((far.0, far.1, far_gap));
-            stack.push((near.0, near.1, gap));
+            self.push_halves(&mut stack, p, (lo, mid, hi), gap);
         }
         best.1
+    }
+
+    /// Pushes the two halves of the range `lo..hi` split at `mid`, the one on `p`'s side on top; the
+    /// far one lies beyond the splitting plane, so its gap to `p` grows to at least that distance.
+    fn push_halves(
+        &self,
+        stack: &mut Vec<(usize, usize, Vec3)>,
+        p: Vec3,
+        (lo, mid, hi): (usize, usize, usize),
+        gap: Vec3,
+    ) {
+        let axis = self.axes[mid] as usize;
+        let offset = p[axis] - self.positions[mid][axis];
+        let (near, far) = if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
+        let mut far_gap = gap;
+        far_gap[axis] = far_gap[axis].max(offset.abs());
+        stack.push((far.0, far.1, far_gap));
+        stack.push((near.0, near.1, gap));
     }
 
     /// The `k` samples nearest to `p`, nearest first, into `out` (cleared first).
@@ -145,14 +155,7 @@ impl PointIndex {
             }
             let mid = (lo + hi) / 2;
             offer(out, mid);
-            let axis = self.axes[mid] as usize;
-            let offset = p[axis] - self.positions[mid][axis];
-            let (near, far) =
-                if offset < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
-            let mut far_gap = gap;
-            far_gap[axis] = far_gap[axis].max(offset.abs());
-            stack.push((far.0, far.1, far_gap));
-            stack.push((near.0, near.1, gap));
+            self.push_halves(&mut stack, p, (lo, mid, hi), gap);
         }
     }
 

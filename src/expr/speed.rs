@@ -74,8 +74,9 @@ pub fn measure(
     })
 }
 
-/// Deterministic points in [-1, 1]³ (a fixed xorshift stream), the same natively and in wasm.
-fn points(count: usize) -> Vec<Vec3> {
+/// Deterministic points in [-1, 1]³ (a fixed xorshift stream), the same natively and in wasm, so
+/// the criterion bench and the browser harness time the same points.
+pub fn points(count: usize) -> Vec<Vec3> {
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
         state ^= state << 13;

@@ -83,6 +83,13 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
     let mut mesh = extract(&values, grid, options)?;
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
+    set_normals(&mut mesh, field);
+    timings.normals_ms = ms_since(t2);
+    Ok((mesh, timings))
+}
+
+/// Vertex normals from the field's gradient where it has one, else from the faces.
+pub(crate) fn set_normals(mesh: &mut Mesh, field: &dyn Field) {
     if mesh.positions.first().is_some_and(|&p| field.gradient(p).is_some()) {
         mesh.normals = mesh
             .positions
@@ -92,8 +99,6 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
     } else {
         mesh.compute_normals_from_faces();
     }
-    timings.normals_ms = ms_since(t2);
-    Ok((mesh, timings))
 }
 
 /// Meshes an already sampled volume (`values` laid out x fastest, see [`Grid::index`]); vertex

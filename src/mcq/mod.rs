@@ -15,7 +15,7 @@ pub use polygon::PolygonRules;
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
-use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since};
+use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since, set_normals};
 use crate::mesh::{analysis, Mesh};
 use crate::tables::polygon_table;
 use glam::Vec3;
@@ -238,15 +238,7 @@ fn extract(
     report.uncross_ms = ms_since(t);
 
     let t = Instant::now();
-    if mesh.positions.first().is_some_and(|&p| field.gradient(p).is_some()) {
-        mesh.normals = mesh
-            .positions
-            .iter()
-            .map(|&p| field.gradient(p).unwrap_or(Vec3::ZERO).normalize_or_zero())
-            .collect();
-    } else {
-        mesh.compute_normals_from_faces();
-    }
+    set_normals(&mut mesh, field);
     report.normals_ms = ms_since(t);
     Ok((mesh, report))
 }

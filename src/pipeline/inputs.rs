@@ -1,14 +1,14 @@
 //! Requests on inputs that are not fields: remeshing a triangle mesh and reconstructing a surface
 //! from an oriented point cloud (EMC's own applications, paper §5.3 and §5.2). `method: "emc"`
 //! gives the directed distances (ray hits, tangent planes); `"mc"` plain Marching Cubes on the same
-//! grid's signed values, the baseline (`"mcq"` with better triangles, `"quad"` quads); `"dmc"` the octree over the trilinear interpolant of those
-//! same values.
+//! grid's signed values, the baseline (`"mcq"` with better triangles); `"dmc"` and `"quad"` the
+//! trilinear interpolant of those same values.
 //!
 //! Without `bounds` the grid covers the input's bounding box padded by two cells, `res` cells
 //! along its longest side ([`padded_grid`]). The error statistics measure against the input itself:
 //! the signed distance to the mesh, or to the tangent plane of the nearest sample.
 
-use super::{Meshed, Method, Output, Request};
+use super::{dmc_on_samples, sampled_res, Meshed, Method, Output, Request};
 use crate::emc::mesh_source::{self, mesh_bounds, padded_grid, MeshBvh};
 use crate::emc::point_source::{self, PointIndex};
 use crate::error::Error;
@@ -16,7 +16,7 @@ use crate::field::{Field, SampleGradient, SampledField};
 use crate::grid::Grid;
 use crate::input::PointCloud;
 use crate::mesh::Mesh;
-use crate::{dmc, mc, mcq, quad};
+use crate::{mc, mcq, quad};
 use glam::Vec3;
 
 /// The request's bounds, or the input's padded by two cells.
@@ -29,40 +29,33 @@ fn input_grid(bounds: (Vec3, Vec3), request: &Request) -> Result<Grid, Error> {
     Ok(grid)
 }
 
-/// Plain MC, or MC with better triangles, on the grid's signed values (sampled in `sample_ms`).
-fn grid_method(values: &[f32], grid: &Grid, request: &Request, sample_ms: f64) -> Result<Meshed, Error> {
-    Ok(if request.method == Method::Mcq {
-        let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
-        Meshed::plain(mesh, mcq::McqReport { sample_ms, ..report }.phases())
-    } else {
-        let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
-        Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+/// The grid methods and DMC on the grid's signed values (sampled in `sample_ms`): plain MC, MC with
+/// better triangles, and DMC and the quad mesher over the trilinear interpolant of the same values.
+/// Those two do not query the input directly: its signs are decided per grid point (votes of rays
+/// through the grid), which a point query cannot match near the input's edges. Not for EMC, which
+/// samples the input along the grid's edges itself.
+fn mesh_signed_values(
+    values: &[f32],
+    grid: &Grid,
+    request: &Request,
+    sample_ms: f64,
+) -> Result<Meshed, Error> {
+    Ok(match request.method {
+        Method::Mcq => {
+            let (mesh, report) = mcq::mesh_samples(values, grid, &request.mcq_options())?;
+            Meshed::plain(mesh, mcq::McqReport { sample_ms, ..report }.phases())
+        }
+        Method::Dmc => dmc_on_samples(values, grid, request)?,
+        Method::Quad => {
+            let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
+            let (out, phases) = quad::mesh_field(&field, grid, &request.quad)?;
+            Meshed::from_quad(out, phases)
+        }
+        _ => {
+            let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
+            Meshed::plain(mesh, mc::McTimings { sample_ms, ..timings }.phases())
+        }
     })
-}
-
-/// DMC over the trilinear interpolant of the same signed values plain MC meshes: the inputs' signs
-/// are decided per grid point (votes of rays through the grid), which a point query cannot match
-/// near the input's edges. The octree's finest level is the grid's.
-fn dmc_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Meshed, Error> {
-    let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
-    let request = Request { res: grid.cells.iter().copied().max().unwrap_or(1), ..request.clone() };
-    let (mesh, stats) = dmc::mesh_field(&field, grid.origin, grid.max(), &request.dmc_options())?;
-    Ok(Meshed::from_dmc(mesh, stats))
-}
-
-/// The quad method over the trilinear interpolant of the same signed values, on the same grid.
-fn quad_on_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Meshed, Error> {
-    let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
-    let (out, phases) = quad::mesh_field(&field, grid, &request.quad)?;
-    Ok(Meshed::from_quad(out, phases))
-}
-
-/// Grid methods report the grid's cells along its longest side; DMC its finest octree level.
-fn reported_res(grid: &Grid, request: &Request) -> usize {
-    match request.method {
-        Method::Dmc => request.reported_res(),
-        _ => grid.cells.iter().copied().max().unwrap_or(0),
-    }
 }
 
 fn iso_must_be_zero(request: &Request, what: &str) -> Result<(), Error> {
@@ -80,19 +73,17 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
     let grid = input_grid(bounds, request)?;
     let source = MeshBvh::new(mesh)?;
     let meshed = match request.method {
-        Method::Mc | Method::Mcq => {
-            let t0 = web_time::Instant::now();
-            let values = mesh_source::grid_values(&source, &grid);
-            grid_method(&values, &grid, request, mc::ms_since(t0))?
-        }
         Method::Emc => {
             let (out, timings) = mesh_source::remesh(mesh, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
-        Method::Dmc => dmc_on_samples(&mesh_source::grid_values(&source, &grid), &grid, request)?,
-        Method::Quad => quad_on_samples(&mesh_source::grid_values(&source, &grid), &grid, request)?,
+        _ => {
+            let t0 = web_time::Instant::now();
+            let values = mesh_source::grid_values(&source, &grid);
+            mesh_signed_values(&values, &grid, request, mc::ms_since(t0))?
+        }
     };
-    let res = reported_res(&grid, request);
+    let res = sampled_res(&grid, request);
     Ok(meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis))
 }
 
@@ -105,19 +96,17 @@ pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Erro
     let grid = input_grid(cloud.bounds(), request)?;
     let index = PointIndex::new(&cloud)?;
     let meshed = match request.method {
-        Method::Mc | Method::Mcq => {
-            let t0 = web_time::Instant::now();
-            let values = point_source::grid_values(&index, &grid);
-            grid_method(&values, &grid, request, mc::ms_since(t0))?
-        }
         Method::Emc => {
             let (out, timings) = point_source::reconstruct(&cloud, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
-        Method::Dmc => dmc_on_samples(&point_source::grid_values(&index, &grid), &grid, request)?,
-        Method::Quad => quad_on_samples(&point_source::grid_values(&index, &grid), &grid, request)?,
+        _ => {
+            let t0 = web_time::Instant::now();
+            let values = point_source::grid_values(&index, &grid);
+            mesh_signed_values(&values, &grid, request, mc::ms_since(t0))?
+        }
     };
-    let res = reported_res(&grid, request);
+    let res = sampled_res(&grid, request);
     Ok(meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis))
 }
 

@@ -37,19 +37,9 @@ pub fn merge(mesh: &QuadMesh, groups: &[(Vec<u32>, Vec3)]) -> Option<QuadMesh> {
 
 /// The neighbours of `v` in turning order around it (a closed fan on a closed manifold).
 pub fn ordered_neighbours(mesh: &QuadMesh, edges: &HashMap<(u32, u32), (u32, u8)>, v: u32) -> Vec<u32> {
-    let mut out = Vec::new();
-    let Some(&(f0, c0)) = edges.iter().find(|(k, _)| k.0 == v).map(|(_, x)| x) else {
-        return out;
-    };
-    let (mut f, mut c) = (f0, c0);
-    loop {
-        let q = mesh.quads[f as usize];
-        out.push(q[(c as usize + 1) % 4]);
-        let prev = q[(c as usize + 3) % 4];
-        (f, c) = edges[&(v, prev)];
-        if f == f0 || out.len() > 64 {
-            return out;
-        }
+    match edges.iter().find(|(k, _)| k.0 == v) {
+        Some((_, &corner)) => ordered_neighbours_from(mesh, edges, corner),
+        None => Vec::new(),
     }
 }
 

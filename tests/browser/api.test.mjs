@@ -3,25 +3,10 @@
 // the wasm package is built.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, packagePage, inPage as runInPage } from '../../scripts/browser.mjs';
-
-let server;
-let browser;
-let page;
-
-before(async () => {
-  server = await serve('www');
-  browser = await launch();
-  page = await packagePage(browser, server.url);
-});
-
-after(async () => {
-  await browser?.close();
-  server?.close();
-});
+import { sharedPackagePage } from '../../scripts/browser.mjs';
 
 /** Runs `body(m, arg)` in the page with the initialised package module `m`. */
-const inPage = (body, arg) => runInPage(page, body, arg);
+const inPage = sharedPackagePage({ before, after });
 
 test('compile returns a reusable shape that meshes at several resolutions', async () => {
   const r = await inPage((m) => {

@@ -2,7 +2,7 @@
 // page served on localhost. Run by scripts/test.sh after the wasm package is built.
 import { test, before, after, afterEach } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch } from '../../scripts/browser.mjs';
+import { serve, launch, canvasColours } from '../../scripts/browser.mjs';
 
 let server;
 let browser;
@@ -105,16 +105,7 @@ test('the viewports draw the meshes (not blank canvases)', async () => {
   const { page } = await openDemo();
   await page.waitForTimeout(300);
   for (const side of [LEFT, RIGHT]) {
-    const colours = await page.$eval(`${side} canvas`, (src) => {
-      const c = document.createElement('canvas');
-      c.width = 64; c.height = 64;
-      const ctx = c.getContext('2d');
-      ctx.drawImage(src, 0, 0, 64, 64);
-      const data = ctx.getImageData(0, 0, 64, 64).data;
-      const seen = new Set();
-      for (let i = 0; i < data.length; i += 4) seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
-      return seen.size;
-    });
+    const { colours } = await canvasColours(page, `${side} canvas`, 64, 64);
     assert.ok(colours > 8, `${side}: only ${colours} distinct colours, the mesh was not drawn`);
   }
   await page.screenshot({ path: 'target/demo-screenshot.png' });

@@ -3,24 +3,10 @@
 // message naming the problem. Run by scripts/test.sh after the wasm package is built.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, packagePage, inPage as runInPage } from '../../scripts/browser.mjs';
+import { sharedPackagePage } from '../../scripts/browser.mjs';
 
-let server;
-let browser;
-let page;
-
-before(async () => {
-  server = await serve('www');
-  browser = await launch();
-  page = await packagePage(browser, server.url);
-});
-
-after(async () => {
-  await browser?.close();
-  server?.close();
-});
-
-const inPage = (body, arg) => runInPage(page, body, arg);
+/** Runs `body(m, arg)` in the page with the initialised package module `m`. */
+const inPage = sharedPackagePage({ before, after });
 
 test('a meshed scene exports as OBJ, STL, PLY and GLB that read back consistently', async () => {
   const r = await inPage((m) => {

@@ -5,7 +5,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
-import { serve, launch } from '../../scripts/browser.mjs';
+import { serve, launch, canvasColours } from '../../scripts/browser.mjs';
 
 let server;
 let browser;
@@ -86,16 +86,7 @@ test("the npm README's three.js example runs as written and draws the mesh", asy
   const [triangles, closed] = logged[0].split(' ');
   assert.ok(Number(triangles) > 0, logged[0]);
   assert.equal(closed, 'true', 'the example shape is a closed manifold');
-  const colours = await page.$eval('canvas', (src) => {
-    const c = document.createElement('canvas');
-    c.width = 64; c.height = 48;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(src, 0, 0, 64, 48);
-    const data = ctx.getImageData(0, 0, 64, 48).data;
-    const seen = new Set();
-    for (let i = 0; i < data.length; i += 4) seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
-    return seen.size;
-  });
+  const { colours } = await canvasColours(page, 'canvas');
   assert.ok(colours > 8, `only ${colours} distinct colours: the example drew nothing`);
   await page.screenshot({ path: 'target/readme-example.png' });
   await page.close();

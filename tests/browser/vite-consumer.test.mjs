@@ -7,7 +7,7 @@ import assert from 'node:assert/strict';
 import { execFile } from 'node:child_process';
 import { existsSync, readdirSync, readFileSync } from 'node:fs';
 import { promisify } from 'node:util';
-import { serve, launch } from '../../scripts/browser.mjs';
+import { serve, launch, canvasColours } from '../../scripts/browser.mjs';
 
 const APP = 'tests/vite-consumer';
 const run = promisify(execFile);
@@ -73,20 +73,7 @@ test('the Vite bundle loads, meshes a scene and draws it with three.js', async (
   const triangles = Number(await page.textContent('#triangles'));
   assert.ok(triangles > 0, `${triangles} triangles`);
   // The canvas is not blank: the flat-shaded normal material paints many colours on white.
-  const { colours, covered } = await page.$eval('#view', (src) => {
-    const c = document.createElement('canvas');
-    c.width = 64; c.height = 48;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(src, 0, 0, 64, 48);
-    const data = ctx.getImageData(0, 0, 64, 48).data;
-    const seen = new Set();
-    let nonWhite = 0;
-    for (let i = 0; i < data.length; i += 4) {
-      seen.add((data[i] >> 4) << 8 | (data[i + 1] >> 4) << 4 | (data[i + 2] >> 4));
-      if (data[i] + data[i + 1] + data[i + 2] < 3 * 250) nonWhite++;
-    }
-    return { colours: seen.size, covered: nonWhite / (64 * 48) };
-  });
+  const { colours, covered } = await canvasColours(page, '#view');
   assert.ok(colours > 8, `only ${colours} distinct colours: the mesh was not drawn`);
   assert.ok(covered > 0.05 && covered < 0.95, `the mesh covers ${(100 * covered).toFixed(1)}% of the canvas`);
   await page.locator('#view').screenshot({ path: 'target/vite-consumer.png' });
