@@ -202,7 +202,7 @@ struct Meshed {
     feature_edges: Vec<[u32; 2]>,
     phases: Vec<(String, f64)>,
     /// Edge features, corner features, flips (EMC).
-    feature_counts: [usize; 3],
+    feature_counts: [usize; 4],
     /// Points evaluated and grid points (EMC).
     evaluations: Option<(usize, usize)>,
     /// Octree leaves and dual cells (DMC).
@@ -217,7 +217,7 @@ impl Meshed {
             mesh,
             feature_edges: vec![],
             phases,
-            feature_counts: [0; 3],
+            feature_counts: [0; 4],
             evaluations: None,
             quads: vec![],
             quad_stages: vec![],
@@ -234,7 +234,7 @@ impl Meshed {
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
         Meshed {
-            feature_counts: [out.edge_features, out.corner_features, out.flips],
+            feature_counts: [out.edge_features, out.corner_features, out.approximate_features, out.flips],
             evaluations: Some((out.points_evaluated, out.grid_points)),
             octree: None,
             phases: timings.phases(),

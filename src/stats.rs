@@ -61,9 +61,13 @@ pub struct Stats {
     pub ms_analysis: f64,
     /// Mesh edges on reconstructed feature lines (EMC), 0 for methods without feature detection.
     pub feature_edges: usize,
-    /// Cells whose component was classified as an edge / a corner feature (EMC).
+    /// Cells whose component was classified as an edge / a corner feature and got a point on it
+    /// (EMC).
     pub edge_features: usize,
     pub corner_features: usize,
+    /// Sharp components fanned around a point near, not on, their feature (EMC): no point of the
+    /// feature gave a fan that does not fold.
+    pub approximate_features: usize,
     /// Edges flipped to make feature lines explicit (EMC).
     pub flips: usize,
     /// Grid points where the field was evaluated (EMC's crust skips the rest), and the grid's size.
@@ -79,10 +83,15 @@ pub struct Stats {
 }
 
 impl Stats {
-    pub(crate) fn set_feature_counts(&mut self, feature_edges: usize, [edges, corners, flips]: [usize; 3]) {
+    pub(crate) fn set_feature_counts(
+        &mut self,
+        feature_edges: usize,
+        [edges, corners, approximate, flips]: [usize; 4],
+    ) {
         self.feature_edges = feature_edges;
         self.edge_features = edges;
         self.corner_features = corners;
+        self.approximate_features = approximate;
         self.flips = flips;
     }
 }

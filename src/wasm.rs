@@ -132,8 +132,10 @@ export interface MeshStats {
   /** Milliseconds per phase, in the order the phases ran. */
   phases_ms: Record<string, number>;
   ms_analysis: number;
-  /** EMC: mesh edges on feature lines, cells with an edge / corner feature, edges flipped (0 for MC). */
-  feature_edges: number; edge_features: number; corner_features: number; flips: number;
+  /** EMC: mesh edges on feature lines, cells with an edge / corner feature point, cells fanned
+   * around a point near (not on) their feature, edges flipped (0 for MC). */
+  feature_edges: number; edge_features: number; corner_features: number; approximate_features: number;
+  flips: number;
   /** EMC: grid points evaluated and the grid's points (null for other methods). */
   points_evaluated: number | null; grid_points: number | null;
   /** DMC: leaves of the final octree and dual cells traversed (null for other methods). */

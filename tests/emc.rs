@@ -24,6 +24,7 @@ struct Comparison {
     mc_error: analysis::SurfaceError,
     emc_error: analysis::SurfaceError,
     h: f32,
+    grid: Grid,
 }
 
 fn compare(field: &dyn Field, res: usize) -> Comparison {
@@ -39,12 +40,36 @@ fn compare(field: &dyn Field, res: usize) -> Comparison {
         emc_error: analysis::surface_error(&emc.mesh, field),
         emc,
         h: grid.cell_size(),
+        grid,
     }
 }
 
 /// Connected components of the graph formed by the feature edges.
 fn feature_line_components(emc: &EmcMesh) -> usize {
-    let n = emc.mesh.vertex_count();
+    components(emc.mesh.vertex_count(), &emc.feature_edges)
+}
+
+/// Connected components of the graph of the mesh edges between fan centres, on the feature or
+/// approximate (vertices off the grid lines): feature lines with their gaps bridged where a
+/// centre could not sit on the feature.
+fn fan_centre_line_components(emc: &EmcMesh, grid: &Grid) -> usize {
+    let crossing = |p: Vec3| {
+        let local = (p - grid.origin) / grid.spacing;
+        (0..3).filter(|&a| (local[a] - local[a].round()).abs() < 1e-3).count() >= 2
+    };
+    let centre: Vec<bool> = emc.mesh.positions.iter().map(|&p| !crossing(p)).collect();
+    let edges: Vec<[u32; 2]> = emc
+        .mesh
+        .triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .filter(|e| e.iter().all(|&v| centre[v as usize]))
+        .collect();
+    components(emc.mesh.vertex_count(), &edges)
+}
+
+/// Connected components of the graph of `edges` over `n` vertices (vertices on no edge ignored).
+fn components(n: usize, edges: &[[u32; 2]]) -> usize {
     let mut parent: Vec<usize> = (0..n).collect();
     fn find(p: &mut [usize], v: usize) -> usize {
         let mut r = v;
@@ -54,12 +79,12 @@ fn feature_line_components(emc: &EmcMesh) -> usize {
         p[v] = r;
         r
     }
-    for &[a, b] in &emc.feature_edges {
+    for &[a, b] in edges {
         let (ra, rb) = (find(&mut parent, a as usize), find(&mut parent, b as usize));
         parent[ra] = rb;
     }
     let used: std::collections::BTreeSet<usize> =
-        emc.feature_edges.iter().flatten().map(|&v| find(&mut parent, v as usize)).collect();
+        edges.iter().flatten().map(|&v| find(&mut parent, v as usize)).collect();
     used.len()
 }
 
@@ -119,22 +144,52 @@ fn rotated_box_is_sharper_and_its_edges_become_feature_lines() {
             "{what}: triangles {tris:.3}x MC's, normal p95 {:.3}° vs MC {:.2}° ({p95:.1}x), distance max {:.2e} vs {:.2e} ({dist:.2}x)",
             c.emc_error.normal_dev_deg_p95, c.mc_error.normal_dev_deg_p95, c.emc_error.dist_max, c.mc_error.dist_max
         );
-        // Measured: 4.0x and 5.1x (p95), 1.97x and 1.53x (max distance) at res 32 and 64.
-        let p95_floor = if res == 32 { 3.5 } else { 4.5 };
-        assert!(p95 > p95_floor, "{what}: normal deviation p95 only {p95:.2}x better");
-        assert!(dist > 1.4, "{what}: max distance only {dist:.2}x better");
+        // Measured: 0.000° against 43.7° and 27.5° (p95); 4.35x and 9.3x (max distance) at res 32
+        // and 64. The floors are 5x and 3x.
+        assert!(p95 > 5.0, "{what}: normal deviation p95 only {p95:.2}x better");
+        assert!(dist > 3.0, "{what}: max distance only {dist:.2}x better");
         assert_eq!(c.emc.corner_features, 8, "{what}: the box's eight corners");
-        // Feature lines cover most of the box's 12 edges (4 × (1 + .7 + .5) = 8.8 long). Not all:
-        // where an edge passes a cell's corner so that its planes meet outside the cell, the cell
-        // stays plain MC and the chain breaks (see the README's EMC notes).
+        // Every feature point lies on an edge of the box (on two faces at once) within 1 % of a
+        // cell; crossings lie on its surface, which checks the frame.
+        let to_box = rotated_box_frame();
+        let faces = |p: Vec3| {
+            let q = to_box * p;
+            let mut d = [(q.x.abs() - 0.5).abs(), (q.y.abs() - 0.35).abs(), (q.z.abs() - 0.25).abs()];
+            d.sort_by(f32::total_cmp);
+            d
+        };
+        for (v, &p) in c.emc.mesh.positions.iter().enumerate() {
+            let d = faces(p);
+            if c.emc.feature_vertex[v] {
+                assert!(d[1] < 0.01 * c.h, "{what}: feature vertex {v} at {p} is {} from an edge", d[1]);
+            } else {
+                assert!(d[0] < 0.2 * c.h, "{what}: vertex {v} at {p} is {} from the box", d[0]);
+            }
+        }
+        // The 12 edges (4 × (1 + .7 + .5) = 8.8 long) come out as feature lines joined at the
+        // corners: one connected graph, as long as the edges.
         let length: f32 = c
             .emc
             .feature_edges
             .iter()
             .map(|&[a, b]| c.emc.mesh.positions[a as usize].distance(c.emc.mesh.positions[b as usize]))
             .sum();
-        assert!(length > 0.78 * 8.8 && length < 1.05 * 8.8, "{what}: feature lines {length} long");
+        let (lines, bridged) = (feature_line_components(&c.emc), fan_centre_line_components(&c.emc, &c.grid));
+        eprintln!(
+            "{what}: feature lines {length} long in {lines} pieces, {bridged} with approximate centres ({} of them)",
+            c.emc.approximate_features
+        );
+        assert!(length > 0.95 * 8.8 && length < 1.05 * 8.8, "{what}: feature lines {length} long");
+        // Measured: 2 and 5 pieces at res 32 and 64, every gap one approximate centre (next to a
+        // corner, where the crease skims a cell's corner): bridged, one connected graph.
+        assert_eq!(bridged, 1, "{what}: feature lines with approximate centres in {bridged} pieces");
     }
+}
+
+/// The rotation taking world coordinates into the frame of ROTATED_BOX's box.
+fn rotated_box_frame() -> glam::Quat {
+    let about = |axis: Vec3, deg: f32| glam::Quat::from_axis_angle(axis.normalize(), deg.to_radians());
+    (about(Vec3::new(0.0, 1.0, 1.0), 31.0) * about(Vec3::X, 23.0)).inverse()
 }
 
 #[test]
@@ -188,6 +243,24 @@ fn every_scene_keeps_mc_topology_without_self_intersections() {
             assert_eq!(emc_topo.components, mc_topo.components, "{what}");
         }
     }
+}
+
+/// On the gyroid at 72 cells (sheets a few cells apart, spurious "features" where they curve
+/// tightly) some fan centres outside their cell cut a neighbour's triangles and are pulled back
+/// in: 27 crossing pairs without that, 12 with it. The 12 left are NOT fixed (see the README):
+/// flips joining two approximate centres of neighbouring cells cut another sheet's triangles.
+#[test]
+fn fans_outside_their_cell_that_cut_a_neighbour_are_pulled_back_inside() {
+    let scene = isoforge::scenes::scene("gyroid").unwrap();
+    let grid = Grid::with_resolution(scene.min, scene.max, 72).unwrap();
+    let (emc, _) = emc::mesh_field(scene.field.as_ref(), &grid, &EmcOptions::default()).unwrap();
+    let (mc_mesh, _) = mc::mesh_field(scene.field.as_ref(), &grid, &McOptions::default()).unwrap();
+    assert!(emc.pulled_back_features > 0, "no fan centre was pulled back into its cell");
+    let (topo, mc_topo) = (analysis::topology(&emc.mesh), analysis::topology(&mc_mesh));
+    assert!(topo.is_closed_manifold(), "{topo:?}");
+    assert_eq!(topo.euler, mc_topo.euler);
+    let crossings = analysis::self_intersections(&emc.mesh);
+    assert!(crossings <= 12, "{crossings} crossing pairs, 12 measured");
 }
 
 /// Share of a mesh's angles below `deg` (a multiple of 5).

@@ -139,21 +139,29 @@ fn rotated_cube_mesh_is_remeshed_with_its_corners_and_flat_faces() {
     assert_eq!(topo.euler, 2);
     assert_eq!(emc.corner_features, 8, "the cube's corners");
     // Edge crossings are on the cube: exact ray hits (moved at most 1e-3 of the edge when they
-    // would otherwise merge with a grid point). Feature points meet two or three faces, except
-    // where the planes meet outside the cell: the point is then clamped into the cell (sliding
-    // out of it can make fans cut their neighbours') and lies off the edge by up to the overshoot.
-    let off_by = |feature: bool| {
+    // would otherwise merge with a grid point); they are the vertices on grid lines. Feature
+    // points meet two or three faces. The other fan centres are approximate (where no point of
+    // the feature gave a fan that does not fold, see `emc::placement`): clamped into the cell or
+    // pulled toward the polygon, off the edge by a fraction of a cell.
+    let on_grid_line = |p: Vec3| {
+        let local = (p - grid.origin) / grid.spacing;
+        (0..3).filter(|&a| (local[a] - local[a].round()).abs() < 1e-3).count() >= 2
+    };
+    let off_by = |keep: &dyn Fn(usize, Vec3) -> bool| {
         emc.mesh
             .positions
             .iter()
-            .zip(&emc.feature_vertex)
-            .filter(|(_, &f)| f == feature)
-            .map(|(&p, _)| b.distance(p).abs() / h)
+            .enumerate()
+            .filter(|&(v, &p)| keep(v, p))
+            .map(|(_, &p)| b.distance(p).abs() / h)
             .fold(0.0, f32::max)
     };
-    let (off, feature_off) = (off_by(false), off_by(true));
+    let off = off_by(&|v, p| !emc.feature_vertex[v] && on_grid_line(p));
+    let feature_off = off_by(&|v, _| emc.feature_vertex[v]);
+    let approximate_off = off_by(&|v, p| !emc.feature_vertex[v] && !on_grid_line(p));
     assert!(off < 1e-3, "a crossing is {off} cells off the cube");
-    assert!(feature_off < 0.2, "a feature point is {feature_off} cells off the cube");
+    assert!(feature_off < 0.01, "a feature point is {feature_off} cells off the cube");
+    assert!(approximate_off < 0.2, "an approximate fan centre is {approximate_off} cells off the cube");
 
     // Plain MC on the same signed values (the paper's scalar distance field) is the baseline.
     let values = grid_values(&MeshBvh::new(&input).unwrap(), &grid);
@@ -189,9 +197,9 @@ fn rotated_cube_mesh_is_remeshed_with_its_corners_and_flat_faces() {
         emc_error.normal_dev_deg_p95,
         mc_error.normal_dev_deg_p95
     );
-    // Cells whose fan would fold stay plain MC (see `rejected_features`), so the largest distance
-    // improves less than the typical one.
-    assert!(emc_error.dist_max * 1.5 < mc_error.dist_max, "{} vs {}", emc_error.dist_max, mc_error.dist_max);
+    // Measured: 0.121 against 0.455 cells. The largest distance improves less than the typical one:
+    // it sits at approximate fan centres where a crease skims a cell's corner.
+    assert!(emc_error.dist_max * 3.0 < mc_error.dist_max, "{} vs {}", emc_error.dist_max, mc_error.dist_max);
     assert!(emc_error.dist_rms * 3.0 < mc_error.dist_rms, "{} vs {}", emc_error.dist_rms, mc_error.dist_rms);
     // The 12 cube edges come back as feature lines (total length 12).
     let length: f32 = emc

@@ -48,6 +48,12 @@ fn octahedron(r: f32) -> Mesh {
 #[test]
 fn an_octahedron_remeshes_closed_with_its_edges_as_feature_lines() {
     let input = octahedron(0.8);
+    // Six corners at every resolution (at 20 and 24 cells next to a corner also used to call
+    // theirs a corner, clamped off it).
+    for res in [16, 20, 24, 28] {
+        let e = pipeline::mesh_triangles(&input, &request(Method::Emc, res)).unwrap();
+        assert_eq!(e.stats.corner_features, 6, "res {res}");
+    }
     let emc = pipeline::mesh_triangles(&input, &request(Method::Emc, 32)).unwrap();
     let mc = pipeline::mesh_triangles(&input, &request(Method::Mc, 32)).unwrap();
     let topo = assert_watertight(&emc.mesh, "remeshed octahedron");
@@ -74,11 +80,11 @@ fn an_octahedron_remeshes_closed_with_its_edges_as_feature_lines() {
         m.triangles,
         mdist / h as f64
     );
-    // Measured: 3.3x (p95), 1.43x (max distance, 0.26 cells: feature points clamped into their
-    // cells where the faces' planes meet outside them).
+    // Measured: p95 0.000° against 27.9°; max distance 0.118 against 0.376 cells (3.2x), at
+    // approximate fan centres next to the corners (see `emc::placement`).
     assert!(e95 * 3.0 < m95, "normal p95 {e95}° against MC's {m95}°");
-    assert!(edist * 1.3 < mdist, "distance {edist} against MC's {mdist}");
-    assert!(edist < 0.3 * h as f64, "distance {edist} is more than 0.3 cells");
+    assert!(edist * 2.5 < mdist, "distance {edist} against MC's {mdist}");
+    assert!(edist < 0.15 * h as f64, "distance {edist} is more than 0.15 cells");
     assert!(e.triangles as f64 <= 1.2 * m.triangles as f64);
     assert_eq!(e.corner_features, 6, "the six vertices");
     assert!(length > 0.8 * edges && length < 1.02 * edges, "feature lines {length} of {edges}");

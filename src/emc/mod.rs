@@ -15,7 +15,9 @@ pub mod edges;
 pub mod feature;
 pub mod flip;
 pub mod mesh_source;
+pub mod placement;
 pub mod point_source;
+pub mod untangle;
 
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
@@ -32,6 +34,8 @@ use crate::tables::{
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, feature_point, FeatureKind};
 use glam::{DVec3, Vec3};
+use placement::{Component, Placed};
+use untangle::{CellTriangleIndex, OutsideFan, OutsideFans};
 use web_time::Instant;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,6 +112,12 @@ pub struct EmcMesh {
     /// Sharp components whose fan around the feature point would fold over (the planes meet
     /// outside the cell) and were meshed as plain MC instead.
     pub rejected_features: usize,
+    /// Sharp components fanned around a point off their feature (see [`placement`]): clamped into
+    /// the cell or pulled toward the polygon, because no point on the feature gave a valid fan.
+    pub approximate_features: usize,
+    /// Fan centres outside their cell moved back inside because their fan cut a neighbour's
+    /// triangles (see [`untangle`]).
+    pub pulled_back_features: usize,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -178,13 +188,16 @@ pub fn mesh_with_sampler(
     check_finite(values, grid)?;
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
-    let mut out = extract(values, grid, options, sampler);
+    let (mut out, fan_centre, outside) = extract(values, grid, options, sampler);
     out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
     if options.flip_edges {
-        out.flips = flip::flip_toward_features(&mut out.mesh, &out.feature_vertex);
+        // Approximate fan centres are flipped toward too: joining neighbouring fan centres is what
+        // takes the chord across a crease out of the mesh, on the crease or near it.
+        out.flips = flip::flip_toward_features(&mut out.mesh, &fan_centre);
     }
+    pull_back(&mut out, grid, &outside);
     out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
     timings.flip_ms = ms_since(t2);
     Ok((out, timings))
@@ -207,7 +220,12 @@ fn crossing(
     (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
 }
 
-fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn EdgeSampler) -> EmcMesh {
+fn extract(
+    values: &[f32],
+    grid: &Grid,
+    options: &EmcOptions,
+    sampler: &dyn EdgeSampler,
+) -> (EmcMesh, Vec<bool>, OutsideFans) {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -219,6 +237,10 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
     };
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
+    let mut cell_triangles = CellTriangleIndex::default();
+    let mut outside_fans: Vec<OutsideFan> = Vec::new();
+    // Per vertex: is it the centre of a feature fan (on the feature or approximately)?
+    let mut fan_centre: Vec<bool> = Vec::new();
 
     for k in 0..cz {
         if k > 0 {
@@ -232,6 +254,7 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                 if case == 0 || case == 255 {
                     continue;
                 }
+                cell_triangles.start(i + cx * (j + cy * k), out.mesh.triangles.len());
                 let (polygons, triangles): (&CellPolygons, &CellTriangles) = match options.topology {
                     Topology::Fixed => (&fixed[case as usize], &fixed_tris[case as usize]),
                     Topology::Trilinear => {
@@ -257,6 +280,7 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
                             out.feature_vertex.push(false);
+                            fan_centre.push(false);
                         }
                         by_edge[e as usize] = *slot;
                     }
@@ -266,35 +290,10 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                     let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        // One bad solve must not throw a spike: the point stays inside its cell
-                        // (strictly, so no fan triangle lies in a cell face) or within half a cell
-                        // of it. Candidates, best first: the point slid along its feature line
-                        // into the cell (an edge's planes fix it only up to that line, so this
-                        // keeps it on the edge where clamping would pull it off; a corner must
-                        // already lie in the cell); then the point clamped into the cell, or into
-                        // the cell grown by half a cell. Sliding along the line out of the cell
-                        // (before or after clamping) made fans cut their neighbours' on the gyroid
-                        // at 24. The first with a valid fan is taken; where none works, the
-                        // component stays plain MC.
                         let solved = feature_point(&pts, &nrm, kind);
-                        let inset = grid.spacing * 1e-2;
-                        let (inner_min, inner_max) = (cell_min + inset, cell_max - inset);
-                        let margin = grid.spacing * 0.5;
-                        let (grown_min, grown_max) = (cell_min - margin, cell_max + margin);
-                        let line = if kind == FeatureKind::Edge { edge_direction(&nrm) } else { None };
-                        let on_feature = |lo: Vec3, hi: Vec3| match line {
-                            Some(dir) => slide_into_box(solved, dir, lo, hi).map(|p| p.clamp(lo, hi)),
-                            None => (solved.cmpge(lo).all() && solved.cmple(hi).all()).then_some(solved),
-                        };
-                        let candidates = [
-                            on_feature(inner_min, inner_max),
-                            Some(solved.clamp(inner_min, inner_max)),
-                            Some(solved.clamp(grown_min, grown_max)),
-                        ];
-                        match candidates.into_iter().flatten().find(|&c| fan_is_valid(c, &pts, &nrm)) {
-                            Some(f) => feature = Some((f, kind)),
-                            None => out.rejected_features += 1,
-                        }
+                        let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max };
+                        feature = placement::place(solved, kind, &component).map(|f| (f, kind));
+                        out.rejected_features += feature.is_none() as usize;
                     }
                     plans.push(Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature });
                 }
@@ -316,7 +315,7 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                 }
                 // Pass 3: emit.
                 for plan in plans {
-                    let Some((f, kind)) = plan.feature else {
+                    let Some((Placed { at: f, inside }, kind)) = plan.feature else {
                         let (tris, extra) =
                             plan.plain(&out.mesh.positions, triangles, options.better_triangles.as_ref());
                         let extra_id = out.mesh.positions.len() as u32;
@@ -324,18 +323,24 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
                             out.mesh.positions.push(c);
                             normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
+                            fan_centre.push(false);
                         }
                         let id = |v: u32| if v == EXTRA { extra_id } else { v };
                         out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
                         continue;
                     };
                     let fid = out.mesh.positions.len() as u32;
-                    out.mesh.positions.push(f);
+                    if let Some(inside) = inside {
+                        outside_fans.push(OutsideFan { vertex: fid, cell: [i, j, k], kind, inside });
+                    }
+                    out.mesh.positions.push(f.position);
                     normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
-                    out.feature_vertex.push(true);
-                    match kind {
-                        FeatureKind::Corner => out.corner_features += 1,
-                        _ => out.edge_features += 1,
+                    out.feature_vertex.push(f.on_feature);
+                    fan_centre.push(true);
+                    match (f.on_feature, kind) {
+                        (false, _) => out.approximate_features += 1,
+                        (true, FeatureKind::Corner) => out.corner_features += 1,
+                        (true, _) => out.edge_features += 1,
                     }
                     let ids = &plan.ids;
                     for q in 0..ids.len() {
@@ -346,7 +351,27 @@ fn extract(values: &[f32], grid: &Grid, options: &EmcOptions, sampler: &dyn Edge
         }
     }
     out.mesh.normals = normals_of_vertex;
-    out
+    (out, fan_centre, OutsideFans { index: cell_triangles, fans: outside_fans })
+}
+
+/// Moves the centres of fans outside their cell that cut a neighbour's triangles back inside
+/// (see [`untangle`]), keeping the feature flags and counts right.
+fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &OutsideFans) {
+    for (f, inside) in untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &outside.fans) {
+        let fan = &outside.fans[f];
+        let v = fan.vertex as usize;
+        out.pulled_back_features += 1;
+        if out.feature_vertex[v] && !inside.on_feature {
+            let count = if fan.kind == FeatureKind::Corner {
+                &mut out.corner_features
+            } else {
+                &mut out.edge_features
+            };
+            *count -= 1;
+            out.approximate_features += 1;
+            out.feature_vertex[v] = false;
+        }
+    }
 }
 
 /// What one component of a cell will become: its polygon and, where sharp, its feature point.
@@ -360,7 +385,9 @@ struct Plan<'a> {
     cell_edges: &'a [u8],
     /// Its triangles in the cell's MC triangulation (triangle indices).
     group: std::ops::Range<usize>,
-    feature: Option<(Vec3, FeatureKind)>,
+    /// Where the fan centre goes, what the feature is, and, for a centre outside the cell, where
+    /// it would go inside (see [`untangle`]).
+    feature: Option<(placement::Placed, FeatureKind)>,
 }
 
 /// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
@@ -377,9 +404,9 @@ impl Plan<'_> {
     ) -> Vec<[DVec3; 3]> {
         let n = self.pts.len();
         match self.feature {
-            Some((f, _)) => {
-                (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
-            }
+            Some((f, _)) => (0..n)
+                .map(|q| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3()))
+                .collect(),
             None => {
                 let (tris, extra) = self.plain(positions, table, rules);
                 let at = |v: u32| match (v, extra) {
@@ -408,49 +435,6 @@ impl Plan<'_> {
         let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
         (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
     }
-}
-
-/// Direction of the feature line of an edge cell: across the two most different normals.
-fn edge_direction(normals: &[Vec3]) -> Option<Vec3> {
-    let mut best = (f32::INFINITY, Vec3::ZERO);
-    for i in 0..normals.len() {
-        for j in i + 1..normals.len() {
-            let d = normals[i].dot(normals[j]);
-            if d < best.0 {
-                best = (d, normals[i].cross(normals[j]));
-            }
-        }
-    }
-    let dir = best.1.normalize_or_zero();
-    (dir != Vec3::ZERO).then_some(dir)
-}
-
-/// The point of the line `p + s dir` inside `[lo, hi]` nearest to `p`, if the line meets the box.
-fn slide_into_box(p: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<Vec3> {
-    let (mut s0, mut s1) = (f32::NEG_INFINITY, f32::INFINITY);
-    for a in 0..3 {
-        if dir[a] == 0.0 {
-            if p[a] < lo[a] || p[a] > hi[a] {
-                return None;
-            }
-            continue;
-        }
-        let (t0, t1) = ((lo[a] - p[a]) / dir[a], (hi[a] - p[a]) / dir[a]);
-        s0 = s0.max(t0.min(t1));
-        s1 = s1.min(t0.max(t1));
-    }
-    (s0 <= s1).then(|| p + dir * 0.0f32.clamp(s0, s1))
-}
-
-/// A fan around `center` is valid when every triangle faces the way the field's normals at its
-/// two polygon vertices do (no fold-over) and none is degenerate.
-fn fan_is_valid(center: Vec3, pts: &[Vec3], nrm: &[Vec3]) -> bool {
-    (0..pts.len()).all(|q| {
-        let r = (q + 1) % pts.len();
-        let n = (pts[q] - center).cross(pts[r] - center);
-        let scale = (pts[q] - center).length() * (pts[r] - center).length();
-        n.length() > 1e-6 * scale && n.dot(nrm[q] + nrm[r]) > 0.0
-    })
 }
 
 /// Mesh edges whose two ends are feature vertices, each once.

@@ -35,7 +35,7 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
     let mut pairs = Vec::new();
     bvh.overlapping_pairs(&boxes, |i, j| {
         let (s, t) = (ids[i as usize], ids[j as usize]);
-        if pair_intersects(mesh, s as usize, t as usize) {
+        if triangle_pair_intersects(mesh, s as usize, t as usize) {
             pairs.push([s.min(t), s.max(t)]);
         }
     });
@@ -43,7 +43,8 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
     pairs
 }
 
-fn pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
+/// Whether triangles `s` and `t` of `mesh` intersect, by the rules of this module.
+pub fn triangle_pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
     let (ts, tt) = (mesh.triangles[s], mesh.triangles[t]);
     let mut shared = None;
     let mut count = 0;

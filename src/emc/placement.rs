@@ -1,0 +1,230 @@
+//! Where a feature point goes once the tangent planes are solved.
+//!
+//! The least-squares point is exact on a clean crease, but EMC fans it to the cell's MC polygon,
+//! and MC's polygon is only what the corner signs saw: where a crease skims a cell's edge or corner,
+//! the surface crosses some cell edges twice, the polygon misses that part, and a fan around the
+//! exact point folds over. Giving up there (plain MC) cuts the crease off by up to a fifth of a cell,
+//! which on a box turned against the grid was the whole of EMC's maximum error. So the point is
+//! placed by a short list of candidates, best first, and the first whose fan does not fold is taken:
+//!
+//! 1. the solved point slid along its feature line into the cell (an edge's planes fix it only up
+//!    to that line; a corner must already lie in the cell);
+//! 2. for an edge, the point of the feature line nearest to that one whose fan is valid, first
+//!    inside the cell, then in the cell grown by half a cell; for a corner, the solved point itself
+//!    when it lies in the grown cell. These are still exactly on the crease;
+//! 3. the solved point clamped into the cell, then into the grown cell (off the crease, but near);
+//! 4. the first valid point on the way from the polygon's centroid (where MC's centre vertex would
+//!    be) to the in-cell point of 1 or 3: it still bends the patch toward the crease.
+//!
+//! Where none is valid, the component stays plain MC. Points stay strictly inside the cell in 1
+//! and 3 (a fan triangle lying in a cell face would overlap the neighbour's).
+
+use super::feature::FeatureKind;
+use glam::Vec3;
+
+/// How far (in cells) points placed in the cell stay off its faces.
+const INSET: f32 = 1e-2;
+/// Samples along a feature line when searching it for a valid fan.
+const LINE_SAMPLES: usize = 32;
+/// How far (in cells) a fan centre may leave its cell, where the planes meet just outside it.
+pub const GROWTH: f32 = 0.5;
+/// Steps from the polygon's centroid toward the target in the last resort.
+const TOWARD_STEPS: usize = 10;
+
+/// The surface component a feature point is placed for: its MC polygon and the field normals at
+/// the polygon's vertices, and the cell it lies in.
+pub struct Component<'a> {
+    pub pts: &'a [Vec3],
+    pub nrm: &'a [Vec3],
+    pub cell_min: Vec3,
+    pub cell_max: Vec3,
+}
+
+/// Where a fan centre went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    pub position: Vec3,
+    /// On the solved feature (candidates 1 and 2): a feature vertex. Otherwise (3 and 4) only an
+    /// approximation that bends the patch toward it.
+    pub on_feature: bool,
+}
+
+/// The position of the feature point of `component` whose least-squares solution is `solved`,
+/// or `None` when no candidate gives a fan that does not fold (the component stays plain MC).
+///
+/// A centre outside the cell comes with the best centre inside it (`inside`), where it moves if
+/// its fan turns out to cut a neighbour's triangles (see [`super::untangle`]); a component that
+/// has no valid centre inside its cell is not given one outside either.
+pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
+    let at = place_within(solved, kind, component, GROWTH)?;
+    let p = at.position;
+    if p.cmpge(component.cell_min).all() && p.cmple(component.cell_max).all() {
+        return Some(Placed { at, inside: None });
+    }
+    let inside = place_within(solved, kind, component, -INSET)?;
+    Some(Placed { at, inside: Some(inside) })
+}
+
+/// A fan centre, and where it goes if it must stay in its cell (only when it is outside).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placed {
+    pub at: Placement,
+    pub inside: Option<Placement>,
+}
+
+fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: f32) -> Option<Placement> {
+    let (pts, nrm) = (component.pts, component.nrm);
+    let spacing = component.cell_max - component.cell_min;
+    let inset = spacing * INSET;
+    let inner = (component.cell_min + inset, component.cell_max - inset);
+    let margin = spacing * growth;
+    let grown = (component.cell_min - margin, component.cell_max + margin);
+    let valid = |c: Vec3| fan_is_valid(c, pts, nrm);
+    let line = match kind {
+        FeatureKind::Edge => edge_direction(nrm),
+        _ => None,
+    };
+    let in_box = |(lo, hi): (Vec3, Vec3)| match line {
+        Some(dir) => line_in_box(solved, dir, lo, hi)
+            .map(|(s0, s1)| (solved + dir * 0.0f32.clamp(s0, s1)).clamp(lo, hi)),
+        None => (solved.cmpge(lo).all() && solved.cmple(hi).all()).then_some(solved),
+    };
+    let on_crease = in_box(inner);
+    let along = |bounds: (Vec3, Vec3)| match line {
+        Some(dir) => search_line(solved, dir, bounds, valid),
+        None => in_box(bounds).filter(|&c| valid(c)),
+    };
+    let clamped = solved.clamp(inner.0, inner.1);
+    let exact = on_crease.filter(|&c| valid(c)).or_else(|| along(inner)).or_else(|| along(grown));
+    if let Some(position) = exact {
+        return Some(Placement { position, on_feature: true });
+    }
+    Some(clamped)
+        .filter(|&c| valid(c))
+        .or_else(|| Some(solved.clamp(grown.0, grown.1)).filter(|&c| valid(c)))
+        .or_else(|| {
+            let centroid = pts.iter().sum::<Vec3>() / pts.len() as f32;
+            let target = on_crease.unwrap_or(clamped);
+            (0..TOWARD_STEPS)
+                .rev()
+                .map(|q| centroid.lerp(target, q as f32 / TOWARD_STEPS as f32))
+                .find(|&c| valid(c))
+        })
+        .map(|position| Placement { position, on_feature: false })
+}
+
+/// Direction of the feature line of an edge cell: across the two most different normals.
+fn edge_direction(normals: &[Vec3]) -> Option<Vec3> {
+    let mut best = (f32::INFINITY, Vec3::ZERO);
+    for i in 0..normals.len() {
+        for j in i + 1..normals.len() {
+            let d = normals[i].dot(normals[j]);
+            if d < best.0 {
+                best = (d, normals[i].cross(normals[j]));
+            }
+        }
+    }
+    let dir = best.1.normalize_or_zero();
+    (dir != Vec3::ZERO).then_some(dir)
+}
+
+/// The parameter interval `[s0, s1]` of the line `p + s dir` inside `[lo, hi]`, if it meets it.
+fn line_in_box(p: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
+    let (mut s0, mut s1) = (f32::NEG_INFINITY, f32::INFINITY);
+    for a in 0..3 {
+        if dir[a] == 0.0 {
+            if p[a] < lo[a] || p[a] > hi[a] {
+                return None;
+            }
+            continue;
+        }
+        let (t0, t1) = ((lo[a] - p[a]) / dir[a], (hi[a] - p[a]) / dir[a]);
+        s0 = s0.max(t0.min(t1));
+        s1 = s1.min(t0.max(t1));
+    }
+    (s0 <= s1).then_some((s0, s1))
+}
+
+/// The valid point of the line `p + s dir` inside `bounds` nearest to `p`, among evenly spaced
+/// samples of the part of the line in the box.
+fn search_line(p: Vec3, dir: Vec3, bounds: (Vec3, Vec3), valid: impl Fn(Vec3) -> bool) -> Option<Vec3> {
+    let (lo, hi) = bounds;
+    let (s0, s1) = line_in_box(p, dir, lo, hi)?;
+    let mut steps: Vec<f32> =
+        (0..=LINE_SAMPLES).map(|q| s0 + (s1 - s0) * q as f32 / LINE_SAMPLES as f32).collect();
+    steps.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
+    steps.into_iter().map(|s| (p + dir * s).clamp(lo, hi)).find(|&c| valid(c))
+}
+
+/// A fan around `center` is valid when every triangle faces the way the field's normals at its
+/// two polygon vertices do (no fold-over) and none is degenerate.
+fn fan_is_valid(center: Vec3, pts: &[Vec3], nrm: &[Vec3]) -> bool {
+    (0..pts.len()).all(|q| {
+        let r = (q + 1) % pts.len();
+        let n = (pts[q] - center).cross(pts[r] - center);
+        let scale = (pts[q] - center).length() * (pts[r] - center).length();
+        n.length() > 1e-6 * scale && n.dot(nrm[q] + nrm[r]) > 0.0
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A crease that skims the corner of the cell: the polygon is a small triangle around corner
+    /// (0, 0, 1) while the two planes meet well inside the cell, so a fan around the exact point
+    /// folds. Taken from the rotated box at res 32.
+    #[test]
+    fn a_crease_skimming_a_corner_still_gets_a_point_on_or_near_it() {
+        let a = Vec3::new(-0.477535, 0.29708743, -0.8268612);
+        let b = Vec3::new(0.8571673, 0.3641869, -0.3641869);
+        let pts = [
+            Vec3::new(0.0, 0.0, 0.99338245),
+            Vec3::new(0.0, 0.018419504, 1.0),
+            Vec3::new(0.5092139, 0.0, 1.0),
+        ];
+        let nrm = [a, a, b];
+        let solved = Vec3::new(0.377, 0.136, 0.824);
+        assert!(!fan_is_valid(solved, &pts, &nrm), "the exact point folds: the case this module is for");
+        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        let placed = place(solved, FeatureKind::Edge, &component).expect("a valid fan").at;
+        assert!(!placed.on_feature, "no point of the crease gives a valid fan here");
+        let p = placed.position;
+        assert!(fan_is_valid(p, &pts, &nrm));
+        let centroid = pts.iter().sum::<Vec3>() / 3.0;
+        let dir = a.cross(b).normalize();
+        let off_crease = |q: Vec3| (q - solved).reject_from_normalized(dir).length();
+        assert!(
+            off_crease(p) < off_crease(centroid),
+            "{p}: {} against MC's centre {}",
+            off_crease(p),
+            off_crease(centroid)
+        );
+    }
+
+    #[test]
+    fn an_edge_point_outside_the_cell_is_slid_along_its_line_into_it() {
+        // Planes x = 0.5 (normal +x) and y = 0.5 (normal +y): the crease is the line x = y = 0.5.
+        let pts = [
+            Vec3::new(0.5, 0.0, 0.8),
+            Vec3::new(0.5, 0.0, 0.2),
+            Vec3::new(0.0, 0.5, 0.2),
+            Vec3::new(0.0, 0.5, 0.8),
+        ];
+        let nrm = [Vec3::X, Vec3::X, Vec3::Y, Vec3::Y];
+        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        // The fan is valid for 0.2 < z < 0.8 only: the nearest valid point of the crease is taken.
+        let placed = place(Vec3::new(0.5, 0.5, 1.4), FeatureKind::Edge, &component).unwrap().at;
+        let p = placed.position;
+        assert!(placed.on_feature);
+        assert!((p.x - 0.5).abs() < 1e-6 && (p.y - 0.5).abs() < 1e-6, "{p} is off the crease");
+        assert!(p.z > 0.75 && p.z < 0.8, "{p} is not the nearest valid point");
+    }
+
+    #[test]
+    fn a_line_that_misses_the_box_has_no_interval() {
+        assert_eq!(line_in_box(Vec3::new(2.0, 0.5, 0.5), Vec3::Y, Vec3::ZERO, Vec3::ONE), None);
+        let (s0, s1) = line_in_box(Vec3::new(0.5, 0.5, 0.5), Vec3::X, Vec3::ZERO, Vec3::ONE).unwrap();
+        assert!((s0 + 0.5).abs() < 1e-6 && (s1 - 0.5).abs() < 1e-6);
+    }
+}
