@@ -11,6 +11,7 @@
 //! directed distances for its remeshing (§5.3) and reconstruction (§5.2) applications.
 
 pub mod crust;
+pub mod directed;
 pub mod edges;
 pub mod feature;
 pub mod flip;
