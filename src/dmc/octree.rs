@@ -43,6 +43,8 @@ pub struct Node {
     pub qef: u32,
     /// Some samples lie inside and some outside: the surface passes through the cell.
     pub straddles: bool,
+    /// Every sample lies inside (below the iso-level).
+    pub inside: bool,
     /// Sliver elimination put the vertex on the surface (restricted QEF).
     pub on_surface: bool,
     /// Sliver elimination must not move this vertex: a neighbour holds a feature.
@@ -89,6 +91,7 @@ impl Octree {
                 children: NONE,
                 qef: NONE,
                 straddles: false,
+                inside: false,
                 on_surface: false,
                 keep_free: false,
                 centred: false,
@@ -161,7 +164,7 @@ impl Octree {
                 }
             }
         }
-        let (qef, straddles) = self.sample(field, n, lo, hi)?;
+        let (qef, below, above) = self.sample(field, n, lo, hi)?;
         let depth = self.nodes[n as usize].depth;
         let solution = qef.minimise_in_box(lo, hi, None);
         if solution.rms > self.params.tolerance as f64 && depth < self.params.max_depth {
@@ -169,7 +172,8 @@ impl Octree {
         }
         let node = &mut self.nodes[n as usize];
         node.kind = Kind::Leaf;
-        node.straddles = straddles;
+        node.straddles = below && above;
+        node.inside = below && !above;
         node.qef = self.qefs.len() as u32;
         self.qefs.push(qef);
         Ok(())
@@ -199,6 +203,7 @@ impl Octree {
                 children: NONE,
                 qef: NONE,
                 straddles: false,
+                inside: false,
                 on_surface: false,
                 keep_free: false,
                 centred: false,
@@ -218,12 +223,12 @@ impl Octree {
     }
 
     /// Samples the closed cell on a regular grid, first and last samples on its faces: the QEF of
-    /// their tangent planes and whether they straddle the iso-level.
+    /// their tangent planes and whether some lie below and some at or above the iso-level.
     ///
     /// Samples on the faces matter: with cell-centred samples a feature within an eighth of a cell of
     /// a face (a box edge at 0.0024 from it, in the measured case) lies outside every sample's
     /// region, the QEF sees one side of it, and the edge is chamfered down to the finest level.
-    fn sample(&mut self, field: &dyn Field, n: u32, lo: Vec3, hi: Vec3) -> Result<(Qef, bool), Error> {
+    fn sample(&mut self, field: &dyn Field, n: u32, lo: Vec3, hi: Vec3) -> Result<(Qef, bool, bool), Error> {
         let k = self.params.samples_per_cell;
         self.points.clear();
         for z in 0..k {
@@ -255,7 +260,7 @@ impl Octree {
             above |= d >= 0.0;
             qef.add(p, d, g);
         }
-        Ok((qef, below && above))
+        Ok((qef, below, above))
     }
 
     /// Leaves (sampled and pruned) in node order.
