@@ -55,7 +55,7 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
                 (centre, field.value(centre) - iso, true, false);
             continue;
         }
-        let linear = node.straddles && tree.qefs[node.qef as usize].rank() == 1;
+        let linear = node.straddles && node.rank == 1;
         let mut vertex = free_minimiser(tree, n, lo, hi);
         let mut value = field.value(vertex) - iso;
         let mut on_surface = false;
@@ -97,7 +97,7 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
 pub fn near_features(tree: &Octree, refs: &[[CellRef; 8]]) -> Vec<u32> {
     let is_feature = |n: u32| {
         let node = &tree.nodes[n as usize];
-        node.kind == Kind::Leaf && node.straddles && tree.qefs[node.qef as usize].rank() >= 2
+        node.kind == Kind::Leaf && node.straddles && node.rank >= 2
     };
     let mut out: Vec<u32> = refs
         .iter()

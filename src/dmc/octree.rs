@@ -52,6 +52,8 @@ pub struct Node {
     pub children: u32,
     /// Index into [`Octree::qefs`], for sampled leaves.
     pub qef: u32,
+    /// [`Qef::rank`] of that QEF, computed once (feature isolation asks every round).
+    pub rank: u8,
     /// Some samples lie inside and some outside: the surface passes through the cell.
     pub straddles: bool,
     /// Every sample lies inside (below the iso-level).
@@ -101,6 +103,7 @@ impl Octree {
                 kind: Kind::Leaf,
                 children: NONE,
                 qef: NONE,
+                rank: 0,
                 straddles: false,
                 inside: false,
                 on_surface: false,
@@ -189,6 +192,7 @@ impl Octree {
         node.straddles = below && above;
         node.inside = below && !above;
         node.qef = self.qefs.len() as u32;
+        node.rank = qef.rank() as u8;
         self.qefs.push(qef);
         Ok(())
     }
@@ -216,6 +220,7 @@ impl Octree {
                 kind: Kind::Leaf,
                 children: NONE,
                 qef: NONE,
+                rank: 0,
                 straddles: false,
                 inside: false,
                 on_surface: false,
