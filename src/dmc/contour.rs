@@ -17,6 +17,7 @@
 //!   linear along the edge.
 
 use super::features::DualVertices;
+use super::memo::Memo;
 use crate::emc::edges::edge_root;
 use crate::field::Field;
 use crate::mesh::Mesh;
@@ -43,7 +44,14 @@ pub struct Contour {
 }
 
 /// Contours dual cells given as eight dual vertex ids each (octant order).
-pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, iso: f32) -> Contour {
+/// Crossings already found in earlier rounds come from `memo`.
+pub fn contour(
+    cells: &[[u32; 8]],
+    vertices: &DualVertices,
+    field: &dyn Field,
+    iso: f32,
+    memo: &mut Memo,
+) -> Contour {
     let table = triangle_table();
     let mut out = Contour::default();
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
@@ -65,7 +73,7 @@ pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, i
                     let [a, b] = EDGES[e].map(|corner| ids[corner as usize]);
                     let (inside, outside) = if vertices.values[a as usize] < 0.0 { (a, b) } else { (b, a) };
                     local[e] = *edges.entry((inside, outside)).or_insert_with(|| {
-                        let t = crossing(vertices, field, iso, inside, outside);
+                        let t = crossing(vertices, field, iso, inside, outside, memo);
                         out.crossings.push(Crossing { inside, outside, t });
                         let (pa, pb) =
                             (vertices.positions[inside as usize], vertices.positions[outside as usize]);
@@ -84,10 +92,17 @@ pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, i
     out
 }
 
-fn crossing(vertices: &DualVertices, field: &dyn Field, iso: f32, inside: u32, outside: u32) -> f32 {
+fn crossing(
+    vertices: &DualVertices,
+    field: &dyn Field,
+    iso: f32,
+    inside: u32,
+    outside: u32,
+    memo: &mut Memo,
+) -> f32 {
     let (pa, pb) = (vertices.positions[inside as usize], vertices.positions[outside as usize]);
     let (va, vb) = (vertices.values[inside as usize], vertices.values[outside as usize]);
-    edge_root(field, iso, pa, pb, va, vb)
+    memo.crossing(pa, va, pb, vb, || edge_root(field, iso, pa, pb, va, vb))
 }
 
 /// Unit normals from the field's gradient (central differences where it has none).

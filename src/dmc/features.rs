@@ -16,6 +16,8 @@
 //!   put its vertex at its centre, on whichever side the centre happens to be, and a whole edge of a
 //!   box in general position came out chamfered. Such vertices are moved a quarter cell into the
 //!   solid along the gradient (clamped to the leaf), which reproduces convex and concave edges alike.
+//!   A vertex whose value is zero up to rounding gets a sign by rule, not by noise
+//!   ([`snap_noise`]): outside, unless every sample of its leaf is inside.
 //! - **Sliver elimination (§4).** Where a linear cell straddles the surface and the QEF restricted
 //!   to `w = 0` has a residual within the tolerance (and the field there is within the tolerance of
 //!   zero), the restricted minimiser, a point on the surface, becomes the vertex, *counted as
@@ -53,7 +55,7 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
                 (centre, field.value(centre) - iso, true, false);
             continue;
         }
-        let linear = node.straddles && tree.qefs[node.qef as usize].rank() == 1;
+        let linear = node.straddles && node.rank == 1;
         let mut vertex = free_minimiser(tree, n, lo, hi);
         let mut value = field.value(vertex) - iso;
         let mut on_surface = false;
@@ -78,6 +80,9 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
                 value = field.value(vertex) - iso;
             }
         }
+        if !on_surface {
+            value = snap_noise(field, vertex, value, tree.size, node.inside);
+        }
         let node = &mut tree.nodes[n as usize];
         node.vertex = vertex;
         node.value = value;
@@ -92,7 +97,7 @@ pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
 pub fn near_features(tree: &Octree, refs: &[[CellRef; 8]]) -> Vec<u32> {
     let is_feature = |n: u32| {
         let node = &tree.nodes[n as usize];
-        node.kind == Kind::Leaf && node.straddles && tree.qefs[node.qef as usize].rank() >= 2
+        node.kind == Kind::Leaf && node.straddles && node.rank >= 2
     };
     let mut out: Vec<u32> = refs
         .iter()
@@ -181,5 +186,40 @@ fn boundary_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) 
         _ if node.centred => (lo + hi) * 0.5,
         _ => free_minimiser(tree, r.node, lo, hi),
     };
-    (p, field.value(p) - tree.params.iso)
+    (p, snap_noise(field, p, field.value(p) - tree.params.iso, tree.size, node.inside))
+}
+
+/// Distance from the iso-level (as a fraction of the root's side) below which a vertex's value is
+/// rounding noise: the vertex lies on the surface, placed there by the QEF.
+pub const ON_SURFACE: f32 = 1e-6;
+
+/// `value` at `p`, or, when it is within rounding noise of the iso-level, the sign of the leaf's
+/// samples: inside (`-MIN_POSITIVE`) when all of them are, else `0` (outside).
+///
+/// A vertex the QEF puts on a sharp corner or edge of the surface has a value that is zero up to
+/// rounding, with a sign that is noise. Counted inside at a convex corner, it meets the inside
+/// vertices of the solid only across faces of the dual cells that are ambiguous, and the table
+/// (which separates inside corners there) leaves it alone: a tiny closed component around the
+/// corner (the rotated box). Counted outside, as the crate's rule for a value of exactly zero says,
+/// it joins the outside vertices across those faces, and the surface passes between it and the
+/// solid, next to it (crossings are found by root finding).
+///
+/// A ridge of the field that only touches the iso-level inside the solid is the other case: the
+/// disc where a union's two parts meet face to face (the rocket's body and nose) has `f = 0` and
+/// `f < 0` on both sides. Its leaves' samples are all inside, and so is the vertex; counted outside,
+/// it would be a flat closed component of its own.
+fn snap_noise(field: &dyn Field, p: Vec3, value: f32, root_size: f32, inside: bool) -> f32 {
+    let tiny = ON_SURFACE * root_size;
+    // No gradient needed for values far from noise (slopes above 1000 are not expected).
+    if value.abs() > tiny * 1e3 {
+        return value;
+    }
+    let g = field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, tiny * 10.0));
+    if value.abs() > tiny * g.length() {
+        value
+    } else if inside {
+        -f32::MIN_POSITIVE
+    } else {
+        0.0
+    }
 }

@@ -10,6 +10,7 @@
 //! - [`dual`]: the cellProc/faceProc/edgeProc/vertProc traversal listing the dual cells, the root's
 //!   boundary included.
 //! - [`contour`]: Marching Cubes on the dual cells, crossings shared per dual edge.
+//! - [`memo`]: root finding, gradients and triangle errors remembered across refinement rounds.
 //! - [`refine`]: the fixpoints run once the dual grid is known (un-pruning, representing every
 //!   straddling leaf, splitting leaves under inaccurate triangles).
 //! - [`slivers`]: collapsing the tiny triangles around vertices that lie on the surface.
@@ -22,6 +23,7 @@
 pub mod contour;
 pub mod dual;
 pub mod features;
+pub mod memo;
 pub mod octree;
 pub mod qef;
 pub mod refine;
@@ -162,6 +164,7 @@ pub fn mesh_field(
     let mut tree =
         Octree::build(field, (min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)?;
     stats.octree_ms += ms_since(t);
+    let mut memo = memo::Memo::default();
     let mut contour = loop {
         stats.rounds += 1;
         let t = Instant::now();
@@ -195,11 +198,11 @@ pub fn mesh_field(
         let revert = features::near_features(&tree, &refs);
 
         let t = Instant::now();
-        let contour = contour::contour(&ids, &vertices, field, options.iso);
+        let contour = contour::contour(&ids, &vertices, field, options.iso, &mut memo);
         stats.contour_ms += ms_since(t);
 
         let t = Instant::now();
-        let plan = refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour);
+        let plan = refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour, &mut memo);
         for &n in &revert {
             let node = &mut tree.nodes[n as usize];
             node.keep_free = true;

@@ -28,6 +28,7 @@
 
 use super::contour::{triangle_error, Contour};
 use super::dual::CellRef;
+use super::memo::Memo;
 use super::octree::{Kind, Octree};
 use crate::field::{finite_difference_gradient, Field};
 use glam::Vec3;
@@ -99,7 +100,8 @@ fn splittable(tree: &Octree, n: u32) -> bool {
     tree.nodes[n as usize].kind == Kind::Leaf && tree.nodes[n as usize].depth < tree.params.max_depth
 }
 
-/// Rules 2, 3 and 4 on a contour of the mixed dual cells `refs` (vertex ids `ids`).
+/// Rules 2, 3 and 4 on a contour of the mixed dual cells `refs` (vertex ids `ids`); gradients and
+/// triangle errors measured in earlier rounds come from `memo`.
 ///
 /// Rule 4: a triangle facing away from the field's gradient at all three of its vertices (which lie
 /// on the surface, so their gradient is the surface normal of their own sheet) is folded over.
@@ -113,6 +115,7 @@ pub fn plan(
     ids: &[[u32; 8]],
     values: &[f32],
     contour: &Contour,
+    memo: &mut Memo,
 ) -> Plan {
     let mut plan = Plan::default();
     let mut represented = vec![false; tree.nodes.len()];
@@ -133,7 +136,9 @@ pub fn plan(
     let gradients: Vec<Vec3> = mesh
         .positions
         .iter()
-        .map(|&p| field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)))
+        .map(|&p| {
+            memo.gradient(p, || field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)))
+        })
         .collect();
     let mut inaccurate = Vec::new();
     let mut folded = Vec::new();
@@ -142,7 +147,7 @@ pub fn plan(
         let normal = (b - a).cross(c - a);
         if mesh.triangles[t].iter().all(|&v| normal.dot(gradients[v as usize]) < 0.0) {
             folded.push(contour.cell_of_triangle[t]);
-        } else if triangle_error(mesh, t, field, tree.params.iso, h) > tolerance {
+        } else if memo.error([a, b, c], || triangle_error(mesh, t, field, tree.params.iso, h)) > tolerance {
             inaccurate.push(contour.cell_of_triangle[t]);
         }
     }
