@@ -139,16 +139,9 @@ impl DmcStats {
     }
 }
 
-/// Meshes the `iso` level of `field` inside the box `[min, max]` (the octree's root is the cube
-/// around its centre with the box's longest side).
-pub fn mesh_field(
-    field: &dyn Field,
-    min: Vec3,
-    max: Vec3,
-    options: &DmcOptions,
-) -> Result<(Mesh, DmcStats), Error> {
-    options.validate()?;
-    Grid::new(min, max, [1, 1, 1])?;
+/// The octree's root cube (lowest corner and side) for the box `[min, max]`, and the build
+/// parameters in world units.
+pub fn octree_root(min: Vec3, max: Vec3, options: &DmcOptions) -> (Vec3, f32, Params) {
     let longest = (max - min).max_element();
     let size = longest * ROOT_GROWTH;
     let params = Params {
@@ -159,10 +152,23 @@ pub fn mesh_field(
         prune: options.prune,
         max_leaves: options.max_cells,
     };
+    ((min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)
+}
+
+/// Meshes the `iso` level of `field` inside the box `[min, max]` (the octree's root is the cube
+/// around its centre with the box's longest side).
+pub fn mesh_field(
+    field: &dyn Field,
+    min: Vec3,
+    max: Vec3,
+    options: &DmcOptions,
+) -> Result<(Mesh, DmcStats), Error> {
+    options.validate()?;
+    Grid::new(min, max, [1, 1, 1])?;
+    let (root_min, size, params) = octree_root(min, max, options);
     let mut stats = DmcStats::default();
     let t = Instant::now();
-    let mut tree =
-        Octree::build(field, (min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)?;
+    let mut tree = Octree::build(field, root_min, size, params)?;
     stats.octree_ms += ms_since(t);
     let mut memo = memo::Memo::default();
     let mut contour = loop {
