@@ -193,12 +193,21 @@ pub fn mesh_with_sampler(
     out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
-    if options.flip_edges {
-        // Approximate fan centres are flipped toward too: joining neighbouring fan centres is what
-        // takes the chord across a crease out of the mesh, on the crease or near it.
-        out.flips = flip::flip_toward_features(&mut out.mesh, &fan_centre);
+    // Flip, then pull back the fans outside their cell that cut a neighbour's triangles; where any
+    // moved, flip again from the unflipped mesh, so that no flip is kept that was made for a
+    // centre's old position (those cut other sheets on the gyroid). Each fan moves at most once.
+    let (unflipped, mut outside) = (out.mesh.triangles.clone(), outside);
+    loop {
+        if options.flip_edges {
+            out.mesh.triangles.clone_from(&unflipped);
+            // Approximate fan centres are flipped toward too (next to one on its feature):
+            // joining neighbouring fan centres takes the chord across a crease out of the mesh.
+            out.flips = flip::flip_toward_features(&mut out.mesh, &fan_centre, &out.feature_vertex);
+        }
+        if pull_back(&mut out, grid, &mut outside) == 0 {
+            break;
+        }
     }
-    pull_back(&mut out, grid, &outside);
     out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
     timings.flip_ms = ms_since(t2);
     Ok((out, timings))
@@ -357,8 +366,10 @@ fn extract(
 
 /// Moves the centres of fans outside their cell that cut a neighbour's triangles back inside
 /// (see [`untangle`]), keeping the feature flags and counts right.
-fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &OutsideFans) {
-    for (f, inside) in untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &outside.fans) {
+/// Returns how many moved; those are dropped from `outside`.
+fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &mut OutsideFans) -> usize {
+    let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &outside.fans);
+    for &(f, inside) in &moved {
         let fan = &outside.fans[f];
         let v = fan.vertex as usize;
         out.pulled_back_features += 1;
@@ -373,6 +384,13 @@ fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &OutsideFans) {
             out.feature_vertex[v] = false;
         }
     }
+    let gone: std::collections::HashSet<usize> = moved.iter().map(|&(f, _)| f).collect();
+    let mut f = 0;
+    outside.fans.retain(|_| {
+        f += 1;
+        !gone.contains(&(f - 1))
+    });
+    moved.len()
 }
 
 /// What one component of a cell will become: its polygon and, where sharp, its feature point.

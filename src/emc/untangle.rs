@@ -72,20 +72,16 @@ pub fn pull_back_crossing_fans(
     let mut moved = Vec::new();
     for (f, fan) in fans.iter().enumerate() {
         let [i, j, k] = fan.cell;
-        let own: Vec<usize> = index
-            .range(linear(i, j, k), count)
-            .filter(|&t| mesh.triangles[t].contains(&fan.vertex))
-            .collect();
         let around = |c: usize, n: usize| c.saturating_sub(1)..(c + 2).min(n);
-        let cuts = around(k, cz).any(|kk| {
-            around(j, cy).any(|jj| {
-                around(i, cx).any(|ii| {
-                    index
-                        .range(linear(ii, jj, kk), count)
-                        .any(|t| own.iter().any(|&s| s != t && triangle_pair_intersects(mesh, s, t)))
-                })
-            })
-        });
+        let nearby: Vec<usize> = around(k, cz)
+            .flat_map(|kk| around(j, cy).flat_map(move |jj| around(i, cx).map(move |ii| linear(ii, jj, kk))))
+            .flat_map(|cell| index.range(cell, count))
+            .collect();
+        // The fan's triangles, flipped ones included (those may sit in a neighbour's range).
+        let own: Vec<usize> =
+            nearby.iter().copied().filter(|&t| mesh.triangles[t].contains(&fan.vertex)).collect();
+        let cuts =
+            nearby.iter().any(|&t| own.iter().any(|&s| s != t && triangle_pair_intersects(mesh, s, t)));
         if cuts {
             mesh.positions[fan.vertex as usize] = fan.inside.position;
             moved.push((f, fan.inside));
