@@ -201,7 +201,7 @@ struct Meshed {
     mesh: Mesh,
     feature_edges: Vec<[u32; 2]>,
     phases: Vec<(String, f64)>,
-    /// Edge features, corner features, flips (EMC).
+    /// Edge features, corner features, approximate features, flips (EMC).
     feature_counts: [usize; 4],
     /// Points evaluated and grid points (EMC).
     evaluations: Option<(usize, usize)>,

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::assert_watertight;
+use common::{assert_watertight, on_grid_line};
 use isoforge::emc::directed::{self, DirectedGrid};
 use isoforge::emc::{self, EmcMesh, EmcOptions};
 use isoforge::mc::{self, McOptions};
@@ -54,11 +54,7 @@ fn feature_line_components(emc: &EmcMesh) -> usize {
 /// approximate (vertices off the grid lines): feature lines with their gaps bridged where a
 /// centre could not sit on the feature.
 fn fan_centre_line_components(emc: &EmcMesh, grid: &Grid) -> usize {
-    let crossing = |p: Vec3| {
-        let local = (p - grid.origin) / grid.spacing;
-        (0..3).filter(|&a| (local[a] - local[a].round()).abs() < 1e-3).count() >= 2
-    };
-    let centre: Vec<bool> = emc.mesh.positions.iter().map(|&p| !crossing(p)).collect();
+    let centre: Vec<bool> = emc.mesh.positions.iter().map(|&p| !on_grid_line(grid, p)).collect();
     let edges: Vec<[u32; 2]> = emc
         .mesh
         .triangles

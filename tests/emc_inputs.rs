@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_watertight, Rng};
+use common::{assert_watertight, on_grid_line, Rng};
 use isoforge::emc::directed::{self, DirectedGrid};
 use isoforge::emc::mesh_source::{self, grid_values, mesh_bounds, padded_grid, MeshBvh};
 use isoforge::emc::point_source;
@@ -144,10 +144,6 @@ fn rotated_cube_mesh_is_remeshed_with_its_corners_and_flat_faces() {
     // points meet two or three faces. The other fan centres are approximate (where no point of
     // the feature gave a fan that does not fold, see `emc::placement`): clamped into the cell or
     // pulled toward the polygon, off the edge by a fraction of a cell.
-    let on_grid_line = |p: Vec3| {
-        let local = (p - grid.origin) / grid.spacing;
-        (0..3).filter(|&a| (local[a] - local[a].round()).abs() < 1e-3).count() >= 2
-    };
     let off_by = |keep: &dyn Fn(usize, Vec3) -> bool| {
         emc.mesh
             .positions
@@ -157,9 +153,9 @@ fn rotated_cube_mesh_is_remeshed_with_its_corners_and_flat_faces() {
             .map(|(_, &p)| b.distance(p).abs() / h)
             .fold(0.0, f32::max)
     };
-    let off = off_by(&|v, p| !emc.feature_vertex[v] && on_grid_line(p));
+    let off = off_by(&|v, p| !emc.feature_vertex[v] && on_grid_line(&grid, p));
     let feature_off = off_by(&|v, _| emc.feature_vertex[v]);
-    let approximate_off = off_by(&|v, p| !emc.feature_vertex[v] && !on_grid_line(p));
+    let approximate_off = off_by(&|v, p| !emc.feature_vertex[v] && !on_grid_line(&grid, p));
     assert!(off < 1e-3, "a crossing is {off} cells off the cube");
     assert!(feature_off < 0.01, "a feature point is {feature_off} cells off the cube");
     assert!(approximate_off < 0.2, "an approximate fan centre is {approximate_off} cells off the cube");

@@ -93,26 +93,33 @@ pub struct Octree {
     values: Vec<f32>,
 }
 
+impl Node {
+    /// A new leaf at `coord` and `depth`, not sampled yet.
+    fn unsampled(coord: [u32; 3], depth: u8) -> Node {
+        Node {
+            coord,
+            depth,
+            kind: Kind::Leaf,
+            children: NONE,
+            qef: NONE,
+            rank: 0,
+            straddles: false,
+            inside: false,
+            on_surface: false,
+            keep_free: false,
+            centred: false,
+            vertex: Vec3::ZERO,
+            value: 0.0,
+            has_vertex: false,
+        }
+    }
+}
+
 impl Octree {
     /// Builds the octree over the cube `[min, min + size]`.
     pub fn build(field: &dyn Field, min: Vec3, size: f32, params: Params) -> Result<Octree, Error> {
         let mut tree = Octree {
-            nodes: vec![Node {
-                coord: [0; 3],
-                depth: 0,
-                kind: Kind::Leaf,
-                children: NONE,
-                qef: NONE,
-                rank: 0,
-                straddles: false,
-                inside: false,
-                on_surface: false,
-                keep_free: false,
-                centred: false,
-                vertex: Vec3::ZERO,
-                value: 0.0,
-                has_vertex: false,
-            }],
+            nodes: vec![Node::unsampled([0; 3], 0)],
             qefs: Vec::new(),
             min,
             size,
@@ -214,22 +221,10 @@ impl Octree {
         let half = 1u32 << (self.params.max_depth - parent.depth - 1);
         for c in 0..8u32 {
             let offset = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
-            self.nodes.push(Node {
-                coord: std::array::from_fn(|a| parent.coord[a] + offset[a] * half),
-                depth: parent.depth + 1,
-                kind: Kind::Leaf,
-                children: NONE,
-                qef: NONE,
-                rank: 0,
-                straddles: false,
-                inside: false,
-                on_surface: false,
-                keep_free: false,
-                centred: false,
-                vertex: Vec3::ZERO,
-                value: 0.0,
-                has_vertex: false,
-            });
+            self.nodes.push(Node::unsampled(
+                std::array::from_fn(|a| parent.coord[a] + offset[a] * half),
+                parent.depth + 1,
+            ));
         }
         let node = &mut self.nodes[n as usize];
         node.kind = Kind::Internal;

@@ -50,22 +50,15 @@ impl DirectedGrid {
     ) -> Result<DirectedGrid, Error> {
         crate::field::check_finite(values, grid)?;
         let inside: Vec<bool> = values.iter().map(|&v| v - iso < 0.0).collect();
-        let [nx, ny, nz] = grid.points();
         let mut hits = vec![[None; 3]; inside.len()];
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    let from = grid.index(i, j, k);
-                    let a = grid.position(i, j, k);
-                    for (axis, next) in neighbours(grid, [i, j, k]) {
-                        if inside[from] != inside[next] {
-                            let mut b = a;
-                            b[axis] += grid.spacing[axis];
-                            let (t, normal) = sampler.crossing(a, b, values[from] - iso, values[next] - iso);
-                            hits[from][axis] = Some(Hit { t: t.clamp(0.0, 1.0), normal });
-                        }
-                    }
-                }
+        for (from, axis, next) in grid_edges(grid) {
+            if inside[from] != inside[next] {
+                let [i, j, k] = grid.unindex(from);
+                let a = grid.position(i, j, k);
+                let mut b = a;
+                b[axis] += grid.spacing[axis];
+                let (t, normal) = sampler.crossing(a, b, values[from] - iso, values[next] - iso);
+                hits[from][axis] = Some(Hit { t: t.clamp(0.0, 1.0), normal });
             }
         }
         Ok(DirectedGrid { grid: *grid, inside, hits })
@@ -140,43 +133,38 @@ impl DirectedGrid {
         let grid = &self.grid;
         let inside: Vec<bool> = self.inside.iter().zip(&other.inside).map(|(&a, &b)| keep(a, b)).collect();
         let mut hits = vec![[None; 3]; inside.len()];
-        let [nx, ny, nz] = grid.points();
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    let from = grid.index(i, j, k);
-                    for (axis, next) in neighbours(grid, [i, j, k]) {
-                        if inside[from] == inside[next] {
-                            continue;
-                        }
-                        // The operands whose side changed the way the result's did.
-                        let changed: Vec<Hit> = [self, other]
-                            .iter()
-                            .filter(|g| g.inside[from] == inside[from] && g.inside[next] == inside[next])
-                            .filter_map(|g| g.hits[from][axis])
-                            .collect();
-                        // Would the result still be on its `from` side if only one operand moved
-                        // to the `next` side? Then both must move: the later crossing counts.
-                        let target = inside[next];
-                        let needs_both = keep(target, !target) != target;
-                        let pick = |a: &Hit, b: &Hit| if (a.t < b.t) == needs_both { *b } else { *a };
-                        hits[from][axis] = changed.iter().copied().reduce(|a, b| pick(&a, &b));
-                    }
-                }
+        for (from, axis, next) in grid_edges(grid) {
+            if inside[from] == inside[next] {
+                continue;
             }
+            // The operands whose side changed the way the result's did.
+            let changed: Vec<Hit> = [self, other]
+                .iter()
+                .filter(|g| g.inside[from] == inside[from] && g.inside[next] == inside[next])
+                .filter_map(|g| g.hits[from][axis])
+                .collect();
+            // Would the result still be on its `from` side if only one operand moved to the
+            // `next` side? Then both must move: the later crossing counts.
+            let target = inside[next];
+            let needs_both = keep(target, !target) != target;
+            let pick = |a: &Hit, b: &Hit| if (a.t < b.t) == needs_both { *b } else { *a };
+            hits[from][axis] = changed.iter().copied().reduce(|a, b| pick(&a, &b));
         }
         Ok(DirectedGrid { grid: *grid, inside, hits })
     }
 }
 
-/// The grid points after `[i, j, k]` along +x, +y, +z that exist, with their axis.
-fn neighbours(grid: &Grid, [i, j, k]: [usize; 3]) -> impl Iterator<Item = (usize, usize)> + '_ {
+/// Every edge of the grid, as (lower point, axis, upper point) by grid index.
+fn grid_edges(grid: &Grid) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
     let [nx, ny, nz] = grid.points();
-    [(i + 1 < nx, [i + 1, j, k]), (j + 1 < ny, [i, j + 1, k]), (k + 1 < nz, [i, j, k + 1])]
-        .into_iter()
-        .enumerate()
-        .filter(|(_, (exists, _))| *exists)
-        .map(move |(axis, (_, [a, b, c]))| (axis, grid.index(a, b, c)))
+    (0..grid.point_count()).flat_map(move |from| {
+        let [i, j, k] = grid.unindex(from);
+        [(i + 1 < nx, [i + 1, j, k]), (j + 1 < ny, [i, j + 1, k]), (k + 1 < nz, [i, j, k + 1])]
+            .into_iter()
+            .enumerate()
+            .filter(|(_, (exists, _))| *exists)
+            .map(move |(axis, (_, [a, b, c]))| (from, axis, grid.index(a, b, c)))
+    })
 }
 
 /// Reads the crossings back for EMC: the edge from `a` along +axis is looked up by its lower end.

@@ -19,21 +19,11 @@ pub enum FeatureKind {
 /// (min nᵢ·nⱼ below it is sharp); `phi_corner` bounds how far normals leave the plane spanned by the
 /// two most different ones (max |nᵢ·n*| above it is a corner).
 pub fn classify(normals: &[Vec3], theta_sharp: f32, phi_corner: f32) -> FeatureKind {
-    let mut theta = 1.0f32;
-    let mut pair = (0, 0);
-    for i in 0..normals.len() {
-        for j in i + 1..normals.len() {
-            let d = normals[i].dot(normals[j]);
-            if d < theta {
-                theta = d;
-                pair = (i, j);
-            }
-        }
-    }
+    let (theta, across) = widest_pair(normals);
     if theta >= theta_sharp {
         return FeatureKind::Smooth;
     }
-    let axis = normals[pair.0].cross(normals[pair.1]).normalize_or_zero();
+    let axis = across.normalize_or_zero();
     if axis == Vec3::ZERO {
         // Opposite normals (a thin sheet): no edge direction to speak of; treat as an edge.
         return FeatureKind::Edge;
@@ -44,6 +34,27 @@ pub fn classify(normals: &[Vec3], theta_sharp: f32, phi_corner: f32) -> FeatureK
     } else {
         FeatureKind::Edge
     }
+}
+
+/// The two most different normals: their dot product (the opening of the normal cone, 1 for fewer
+/// than two normals) and their cross product (along the crease they meet in, not normalised).
+fn widest_pair(normals: &[Vec3]) -> (f32, Vec3) {
+    let mut widest = (1.0f32, Vec3::ZERO);
+    for i in 0..normals.len() {
+        for j in i + 1..normals.len() {
+            let d = normals[i].dot(normals[j]);
+            if d < widest.0 {
+                widest = (d, normals[i].cross(normals[j]));
+            }
+        }
+    }
+    widest
+}
+
+/// Direction of the feature line of an edge component: across its two most different normals.
+pub fn crease_direction(normals: &[Vec3]) -> Option<Vec3> {
+    let dir = widest_pair(normals).1.normalize_or_zero();
+    (dir != Vec3::ZERO).then_some(dir)
 }
 
 /// The point that best lies on all tangent planes (pᵢ, nᵢ), by the SVD pseudo-inverse of the normal

@@ -196,17 +196,19 @@ pub fn mesh_with_sampler(
     // Flip, then pull back the fans outside their cell that cut a neighbour's triangles; where any
     // moved, flip again from the unflipped mesh, so that no flip is kept that was made for a
     // centre's old position (those cut other sheets on the gyroid). Each fan moves at most once.
-    let (unflipped, mut outside) = (out.mesh.triangles.clone(), outside);
-    loop {
+    // Approximate fan centres are flipped toward too (next to one on its feature): joining
+    // neighbouring fan centres takes the chord across a crease out of the mesh.
+    let mut outside = outside;
+    let unflipped = if outside.fans.is_empty() { Vec::new() } else { out.mesh.triangles.clone() };
+    let flip = |out: &mut EmcMesh| {
         if options.flip_edges {
-            out.mesh.triangles.clone_from(&unflipped);
-            // Approximate fan centres are flipped toward too (next to one on its feature):
-            // joining neighbouring fan centres takes the chord across a crease out of the mesh.
             out.flips = flip::flip_toward_features(&mut out.mesh, &fan_centre, &out.feature_vertex);
         }
-        if pull_back(&mut out, grid, &mut outside) == 0 {
-            break;
-        }
+    };
+    flip(&mut out);
+    while pull_back(&mut out, grid, &mut outside) > 0 {
+        out.mesh.triangles.clone_from(&unflipped);
+        flip(&mut out);
     }
     out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
     timings.flip_ms = ms_since(t2);
@@ -264,7 +266,7 @@ fn extract(
                 if case == 0 || case == 255 {
                     continue;
                 }
-                cell_triangles.start(i + cx * (j + cy * k), out.mesh.triangles.len());
+                cell_triangles.start(base, out.mesh.triangles.len());
                 let (polygons, triangles): (&CellPolygons, &CellTriangles) = match options.topology {
                     Topology::Fixed => (&fixed[case as usize], &fixed_tris[case as usize]),
                     Topology::Trilinear => {
@@ -368,12 +370,11 @@ fn extract(
 /// (see [`untangle`]), keeping the feature flags and counts right.
 /// Returns how many moved; those are dropped from `outside`.
 fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &mut OutsideFans) -> usize {
-    let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &outside.fans);
-    for &(f, inside) in &moved {
-        let fan = &outside.fans[f];
+    let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &mut outside.fans);
+    for fan in &moved {
         let v = fan.vertex as usize;
         out.pulled_back_features += 1;
-        if out.feature_vertex[v] && !inside.on_feature {
+        if out.feature_vertex[v] && !fan.inside.on_feature {
             let count = if fan.kind == FeatureKind::Corner {
                 &mut out.corner_features
             } else {
@@ -384,12 +385,6 @@ fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &mut OutsideFans) -> usize
             out.feature_vertex[v] = false;
         }
     }
-    let gone: std::collections::HashSet<usize> = moved.iter().map(|&(f, _)| f).collect();
-    let mut f = 0;
-    outside.fans.retain(|_| {
-        f += 1;
-        !gone.contains(&(f - 1))
-    });
     moved.len()
 }
 

@@ -19,7 +19,7 @@
 //! Where none is valid, the component stays plain MC. Points stay strictly inside the cell in 1
 //! and 3 (a fan triangle lying in a cell face would overlap the neighbour's).
 
-use super::feature::FeatureKind;
+use super::feature::{crease_direction, FeatureKind};
 use glam::Vec3;
 
 /// How far (in cells) points placed in the cell stay off its faces.
@@ -81,7 +81,7 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
     let grown = (component.cell_min - margin, component.cell_max + margin);
     let valid = |c: Vec3| fan_is_valid(c, pts, nrm);
     let line = match kind {
-        FeatureKind::Edge => edge_direction(nrm),
+        FeatureKind::Edge => crease_direction(nrm),
         _ => None,
     };
     let in_box = |(lo, hi): (Vec3, Vec3)| match line {
@@ -111,21 +111,6 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
                 .find(|&c| valid(c))
         })
         .map(|position| Placement { position, on_feature: false })
-}
-
-/// Direction of the feature line of an edge cell: across the two most different normals.
-fn edge_direction(normals: &[Vec3]) -> Option<Vec3> {
-    let mut best = (f32::INFINITY, Vec3::ZERO);
-    for i in 0..normals.len() {
-        for j in i + 1..normals.len() {
-            let d = normals[i].dot(normals[j]);
-            if d < best.0 {
-                best = (d, normals[i].cross(normals[j]));
-            }
-        }
-    }
-    let dir = best.1.normalize_or_zero();
-    (dir != Vec3::ZERO).then_some(dir)
 }
 
 /// The parameter interval `[s0, s1]` of the line `p + s dir` inside `[lo, hi]`, if it meets it.

@@ -15,10 +15,11 @@ use crate::grid::Grid;
 use crate::mesh::analysis::self_intersect::triangle_pair_intersects;
 use crate::mesh::Mesh;
 
-/// Where each cell's triangles start in the mesh: extraction emits cells in index order.
+/// Where each cell's triangles start in the mesh: extraction emits cells in index order. A cell
+/// is named by the grid index of its lowest corner ([`Grid::index`]).
 #[derive(Debug, Default)]
 pub struct CellTriangleIndex {
-    /// (linear cell index, first triangle), for the cells that emitted triangles, ascending.
+    /// (cell, first triangle), for the cells that emitted triangles, ascending.
     starts: Vec<(usize, u32)>,
 }
 
@@ -59,22 +60,23 @@ pub struct OutsideFans {
 }
 
 /// Moves the centre of every fan in `fans` that cuts a triangle of the cells around it to its
-/// inside placement, and returns the moved fans' new placements (by index into `fans`).
+/// inside placement, and takes those fans out of `fans`: the moved ones are returned.
 pub fn pull_back_crossing_fans(
     mesh: &mut Mesh,
     grid: &Grid,
     index: &CellTriangleIndex,
-    fans: &[OutsideFan],
-) -> Vec<(usize, Placement)> {
+    fans: &mut Vec<OutsideFan>,
+) -> Vec<OutsideFan> {
     let [cx, cy, cz] = grid.cells;
-    let linear = |i: usize, j: usize, k: usize| i + cx * (j + cy * k);
     let count = mesh.triangles.len();
     let mut moved = Vec::new();
-    for (f, fan) in fans.iter().enumerate() {
+    fans.retain(|fan| {
         let [i, j, k] = fan.cell;
         let around = |c: usize, n: usize| c.saturating_sub(1)..(c + 2).min(n);
         let nearby: Vec<usize> = around(k, cz)
-            .flat_map(|kk| around(j, cy).flat_map(move |jj| around(i, cx).map(move |ii| linear(ii, jj, kk))))
+            .flat_map(|kk| {
+                around(j, cy).flat_map(move |jj| around(i, cx).map(move |ii| grid.index(ii, jj, kk)))
+            })
             .flat_map(|cell| index.range(cell, count))
             .collect();
         // The fan's triangles, flipped ones included (those may sit in a neighbour's range).
@@ -84,8 +86,9 @@ pub fn pull_back_crossing_fans(
             nearby.iter().any(|&t| own.iter().any(|&s| s != t && triangle_pair_intersects(mesh, s, t)));
         if cuts {
             mesh.positions[fan.vertex as usize] = fan.inside.position;
-            moved.push((f, fan.inside));
+            moved.push(*fan);
         }
-    }
+        !cuts
+    });
     moved
 }

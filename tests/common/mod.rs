@@ -3,7 +3,14 @@
 #![allow(dead_code)]
 
 use isoforge::mesh::analysis;
-use isoforge::Mesh;
+use isoforge::{Grid, Mesh, Vec3};
+
+/// Does `p` lie on a line of `grid` (two of its coordinates on grid planes)? EMC's edge crossings
+/// do; its fan centres and MC's centre vertices do not.
+pub fn on_grid_line(grid: &Grid, p: Vec3) -> bool {
+    let local = (p - grid.origin) / grid.spacing;
+    (0..3).filter(|&a| (local[a] - local[a].round()).abs() < 1e-3).count() >= 2
+}
 
 /// A small seeded generator (splitmix64): reproducible random inputs without a dependency.
 pub struct Rng(u64);
