@@ -33,7 +33,7 @@ use crate::tables::{
     CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS,
 };
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
-use feature::{classify, feature_point, FeatureKind};
+use feature::{classify, FeatureKind};
 use glam::{DVec3, Vec3};
 use placement::{Component, Placed};
 use untangle::{CellTriangleIndex, OutsideFan, OutsideFans};
@@ -302,7 +302,9 @@ fn extract(
                     let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        let solved = feature_point(&pts, &nrm, kind);
+                        let reach = grid.spacing * placement::GROWTH;
+                        let near = (cell_min - reach, cell_max + reach);
+                        let (kind, solved) = feature::sharp_point(&pts, &nrm, kind, near);
                         let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max };
                         feature = placement::place(solved, kind, &component).map(|f| (f, kind));
                         out.rejected_features += feature.is_none() as usize;

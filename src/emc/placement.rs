@@ -14,7 +14,12 @@
 //!    when it lies in the grown cell. These are still exactly on the crease;
 //! 3. the solved point clamped into the cell, then into the grown cell (off the crease, but near);
 //! 4. the first valid point on the way from the polygon's centroid (where MC's centre vertex would
-//!    be) to the in-cell point of 1 or 3: it still bends the patch toward the crease.
+//!    be) to the in-cell point of 1 or 3: it still bends the patch toward the crease;
+//! 5. the point of a lattice over the cell nearest to the feature whose fan is valid: where the
+//!    crease runs just outside the cell (the fandisk's groove rim, whose top face lies within 1 %
+//!    of a cell of a grid plane), even MC's centre folds, but points further in do not. It comes
+//!    after 4 because nearness to the feature *line* is a poor guide where the polygon only sees
+//!    a corner of the crease: there the line's nearest lattice points are off the surface.
 //!
 //! Where none is valid, the component stays plain MC. Points stay strictly inside the cell in 1
 //! and 3 (a fan triangle lying in a cell face would overlap the neighbour's).
@@ -28,6 +33,8 @@ const INSET: f32 = 1e-2;
 const LINE_SAMPLES: usize = 32;
 /// How far (in cells) a fan centre may leave its cell, where the planes meet just outside it.
 pub const GROWTH: f32 = 0.5;
+/// Lattice points per axis when searching the cell for a valid fan near the feature.
+const LATTICE_SAMPLES: usize = 8;
 /// Steps from the polygon's centroid toward the target in the last resort.
 const TOWARD_STEPS: usize = 10;
 
@@ -99,6 +106,10 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
     if let Some(position) = exact {
         return Some(Placement { position, on_feature: true });
     }
+    let off_feature = |c: Vec3| match line {
+        Some(dir) => (c - solved).reject_from_normalized(dir).length(),
+        None => (c - solved).length(),
+    };
     Some(clamped)
         .filter(|&c| valid(c))
         .or_else(|| Some(solved.clamp(grown.0, grown.1)).filter(|&c| valid(c)))
@@ -110,7 +121,29 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
                 .map(|q| centroid.lerp(target, q as f32 / TOWARD_STEPS as f32))
                 .find(|&c| valid(c))
         })
+        .or_else(|| nearest_valid_in_box(inner, off_feature, valid))
         .map(|position| Placement { position, on_feature: false })
+}
+
+/// The point of a lattice over `bounds` nearest to the feature (by `off_feature`) whose fan is
+/// valid. Where a crease runs just outside the cell and only a corner of the cell sees it, no
+/// point of the line and no clamped point gives a valid fan, but points a little further in do.
+fn nearest_valid_in_box(
+    bounds: (Vec3, Vec3),
+    off_feature: impl Fn(Vec3) -> f32,
+    valid: impl Fn(Vec3) -> bool,
+) -> Option<Vec3> {
+    let (lo, hi) = bounds;
+    let n = LATTICE_SAMPLES;
+    let mut lattice: Vec<(f32, Vec3)> = (0..n * n * n)
+        .map(|q| {
+            let at = Vec3::new((q % n) as f32, (q / n % n) as f32, (q / (n * n)) as f32);
+            let c = lo + (hi - lo) * (at + 0.5) / n as f32;
+            (off_feature(c), c)
+        })
+        .collect();
+    lattice.sort_by(|a, b| a.0.total_cmp(&b.0));
+    lattice.into_iter().map(|(_, c)| c).find(|&c| valid(c))
 }
 
 /// The parameter interval `[s0, s1]` of the line `p + s dir` inside `[lo, hi]`, if it meets it.
@@ -185,6 +218,45 @@ mod tests {
             off_crease(p),
             off_crease(centroid)
         );
+    }
+
+    /// The rim of the fandisk's groove at res 64 (cell units): the top surface lies within 1 % of
+    /// a cell of the cell's top face and the crease runs just above it, so no point of the crease,
+    /// no clamped point and not even MC's centre gives a valid fan; points lower in the cell do.
+    #[test]
+    fn a_crease_just_outside_the_cell_gets_a_valid_fan_from_the_lattice() {
+        let (groove, top) = (Vec3::new(0.9965218, 0.0, -0.083333254), Vec3::new(0.0, 0.104166664, 0.9945599));
+        let pts = [
+            Vec3::new(28.816696, 36.0, 42.0),
+            Vec3::new(28.0, 36.0, 42.9911),
+            Vec3::new(28.0, 35.91408, 43.0),
+            Vec3::new(29.0, 35.91408, 43.0),
+            Vec3::new(29.0, 35.0, 42.97113),
+            Vec3::new(28.816696, 35.0, 42.0),
+        ];
+        let nrm = [
+            groove,
+            top,
+            Vec3::new(0.0, 0.101929165, 0.9947917),
+            Vec3::new(0.0, 0.10192924, 0.9947917),
+            Vec3::new(0.9583333, 0.0, -0.28565246),
+            groove,
+        ];
+        let centroid = pts.iter().sum::<Vec3>() / pts.len() as f32;
+        assert!(!fan_is_valid(centroid, &pts, &nrm), "the case this is for");
+        let solved = Vec3::new(28.93747, 35.679848, 43.019165);
+        let cell = Component {
+            pts: &pts,
+            nrm: &nrm,
+            cell_min: Vec3::new(28.0, 35.0, 42.0),
+            cell_max: Vec3::new(29.0, 36.0, 43.0),
+        };
+        let placed = place(solved, FeatureKind::Edge, &cell).expect("a valid fan").at;
+        assert!(!placed.on_feature);
+        assert!(fan_is_valid(placed.position, &pts, &nrm));
+        let off_crease =
+            (placed.position - solved).reject_from_normalized(groove.cross(top).normalize()).length();
+        assert!(off_crease < 0.15, "{} is {off_crease} cells from the crease", placed.position);
     }
 
     #[test]
