@@ -178,6 +178,7 @@ impl Request {
             flip_edges: true,
             crust: true,
             better_triangles: self.better_triangles.then_some(self.mcq_rules),
+            resample_creases: true,
             topology: self.topology,
             max_cells: self.max_cells,
         }

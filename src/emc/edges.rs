@@ -13,6 +13,13 @@ pub trait EdgeSampler {
     /// The crossing on the segment `a → b`, whose end values (minus the iso-level) `da`, `db` have
     /// opposite signs, as the fraction `t` of the way from `a`, and the unit outward normal there.
     fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3);
+
+    /// The crossing on any segment `a → b` (not only a grid edge) whose ends lie on opposite sides,
+    /// found as exactly as [`EdgeSampler::crossing`]; `None` where the sampler only knows grid edges
+    /// (stored records, samples) or the ends lie on one side. Used to resample curved creases.
+    fn crossing_on_segment(&self, _a: Vec3, _b: Vec3) -> Option<(f32, Vec3)> {
+        None
+    }
 }
 
 /// Crossings of a field: exact by root finding (`directed`), or interpolated from the end values;
@@ -29,6 +36,14 @@ impl EdgeSampler for FieldRoots<'_> {
     fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3) {
         let t = if self.directed { edge_root(self.field, self.iso, a, b, da, db) } else { da / (da - db) };
         (t, field_normal(self.field, a + (b - a) * t, self.h * 1e-3))
+    }
+
+    fn crossing_on_segment(&self, a: Vec3, b: Vec3) -> Option<(f32, Vec3)> {
+        if !self.directed {
+            return None;
+        }
+        let (da, db) = (self.field.value(a) - self.iso, self.field.value(b) - self.iso);
+        ((da < 0.0) != (db < 0.0) && da.is_finite() && db.is_finite()).then(|| self.crossing(a, b, da, db))
     }
 }
 

@@ -39,16 +39,25 @@ pub fn classify(normals: &[Vec3], theta_sharp: f32, phi_corner: f32) -> FeatureK
 /// The two most different normals: their dot product (the opening of the normal cone, 1 for fewer
 /// than two normals) and their cross product (along the crease they meet in, not normalised).
 fn widest_pair(normals: &[Vec3]) -> (f32, Vec3) {
-    let mut widest = (1.0f32, Vec3::ZERO);
+    match widest_pair_indices(normals) {
+        Some((i, j)) => (normals[i].dot(normals[j]), normals[i].cross(normals[j])),
+        None => (1.0, Vec3::ZERO),
+    }
+}
+
+/// Which two normals are the most different (smallest dot product), if there are two; the first
+/// such pair when several tie.
+pub fn widest_pair_indices(normals: &[Vec3]) -> Option<(usize, usize)> {
+    let mut widest = (1.0f32, None);
     for i in 0..normals.len() {
         for j in i + 1..normals.len() {
             let d = normals[i].dot(normals[j]);
-            if d < widest.0 {
-                widest = (d, normals[i].cross(normals[j]));
+            if d < widest.0 || widest.1.is_none() {
+                widest = (d, Some((i, j)));
             }
         }
     }
-    widest
+    widest.1
 }
 
 /// Direction of the feature line of an edge component: across its two most different normals.

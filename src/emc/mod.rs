@@ -18,6 +18,7 @@ pub mod flip;
 pub mod mesh_source;
 pub mod placement;
 pub mod point_source;
+pub mod resample;
 pub mod untangle;
 
 use crate::error::Error;
@@ -60,6 +61,10 @@ pub struct EmcOptions {
     /// split the largest angle) instead of MC's table; `None` (default) keeps MC's triangles.
     /// Feature fans are unchanged. No vertex snapping (see the README).
     pub better_triangles: Option<PolygonRules>,
+    /// Move edge points onto curved creases by sampling each sheet again next to the solved point
+    /// (see [`resample`]), where the input can be sampled off the grid edges (functions, with
+    /// `directed`). `false` keeps the paper's tangent-plane point.
+    pub resample_creases: bool,
 }
 
 impl Default for EmcOptions {
@@ -74,6 +79,7 @@ impl Default for EmcOptions {
             max_cells: DEFAULT_MAX_CELLS,
             crust: true,
             better_triangles: None,
+            resample_creases: true,
         }
     }
 }
@@ -304,8 +310,16 @@ fn extract(
                     if kind != FeatureKind::Smooth {
                         let reach = grid.spacing * placement::GROWTH;
                         let near = (cell_min - reach, cell_max + reach);
-                        let (kind, solved) = feature::sharp_point(&pts, &nrm, kind, near);
+                        let (mut kind, mut solved) = feature::sharp_point(&pts, &nrm, kind, near);
                         let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max };
+                        if options.resample_creases {
+                            let theta = options.theta_sharp;
+                            if let Some(better) =
+                                resample::resample_component(solved, kind, &component, sampler, theta)
+                            {
+                                (kind, solved) = better;
+                            }
+                        }
                         feature = placement::place(solved, kind, &component).map(|f| (f, kind));
                         out.rejected_features += feature.is_none() as usize;
                     }
