@@ -142,6 +142,34 @@ fn thin_room_keeps_its_walls_where_mc_at_the_same_depth_loses_them() {
     assert!(tris < 13_000, "{tris} triangles (the paper's 440 is far off; see the README)");
 }
 
+/// The thin room written with planar primitives, as the paper builds it: walls 0.016 thick (1 % of
+/// the room), a door through the wall at y = -0.8 whose sill lies 0.042 above the floor.
+const PLANAR_ROOM: &str = "b = max(abs(x) - 0.8, abs(y) - 0.8, abs(z) - 0.5); room = abs(b) - 0.008; \
+     door = translate(max(abs(x) - 0.2, abs(y) - 0.1, abs(z) - 0.325), 0, -0.8, -0.125); max(room, -door)";
+
+/// The planar room is one closed surface of genus 0 (inside and out joined through the door) at
+/// depths 4 to 6, where the cells are 8 to 2 times the walls' thickness. It had Euler 0 at depth 4
+/// and -4 at depths 5 and 6: where refinement found no leaf left to split under a fold or an
+/// intersection it moved the leaves' vertices to their centres, and a leaf at a wall or at the edge
+/// where two walls meet has its free vertex on the wall's mid-surface (inside) and its centre
+/// outside the wall, so each such centring punched a hole through the wall (see
+/// `refine::keep_signs`). Its triangle counts (2.2 K, 6.3 K, 14.1 K) are far from the paper's 440.
+#[test]
+fn planar_thin_room_keeps_genus_0_where_its_cells_are_wider_than_the_walls() {
+    let field = expr::compile(PLANAR_ROOM).unwrap();
+    let (min, max) = (Vec3::new(-1.0, -1.0, -0.7), Vec3::new(1.0, 1.0, 0.7));
+    for depth in [4, 5, 6] {
+        let options = DmcOptions { max_depth: depth, ..DmcOptions::default() };
+        let (mesh, _) = dmc_mesh(&field, min, max, &options);
+        let topo = assert_watertight(&mesh, &format!("planar room depth {depth}"));
+        assert_eq!(
+            (topo.euler, topo.components),
+            (2, 1),
+            "planar room depth {depth}: one closed surface of genus 0 (the door joins inside and out)"
+        );
+    }
+}
+
 /// The generalised winding number of a closed mesh around `p` (solid angles, Van Oosterom and
 /// Strackee): 1 inside an outward-oriented closed surface, 0 outside.
 fn winding_number(mesh: &Mesh, p: Vec3) -> f64 {

@@ -28,7 +28,9 @@
 //!   thin wall folded the contour there.
 //! - A pruned leaf's vertex is its centre (flattened onto the boundary for boundary cells); it never
 //!   reaches the output (see `refine.rs`). So is a *centred* leaf's, the fallback of refinement
-//!   rules 4 and 5.
+//!   rules 4 and 5, unless the centre lies on the other side of the iso-level and that would add
+//!   topology (`refine::keep_signs`): then the vertex moves from its free place toward the centre
+//!   only halfway to the first sign change, keeping its side.
 
 use super::dual::CellRef;
 use super::octree::{Kind, Octree, NONE};
@@ -41,54 +43,73 @@ pub const SHRINK: f32 = 1e-4;
 
 /// Places the vertex of every sampled leaf that has none yet.
 pub fn isolate(tree: &mut Octree, field: &dyn Field, sliver_elimination: bool) {
-    let iso = tree.params.iso;
     for n in 0..tree.nodes.len() as u32 {
         let node = tree.nodes[n as usize];
         if node.kind != Kind::Leaf || node.has_vertex {
             continue;
         }
-        let (lo, hi) = shrunk(tree, n);
-        if node.centred {
-            let centre = (lo + hi) * 0.5;
-            let node = &mut tree.nodes[n as usize];
-            (node.vertex, node.value, node.has_vertex, node.on_surface) =
-                (centre, field.value(centre) - iso, true, false);
-            continue;
-        }
-        let linear = node.straddles && node.rank == 1;
-        let mut vertex = free_minimiser(tree, n, lo, hi);
-        let mut value = field.value(vertex) - iso;
-        let mut on_surface = false;
-        if sliver_elimination && linear && !node.keep_free {
-            let restricted = tree.qefs[node.qef as usize].minimise_in_box(lo, hi, Some(0.0));
-            let p = restricted.position.as_vec3();
-            let v = field.value(p) - iso;
-            if restricted.rms <= tree.params.tolerance as f64 && v.abs() <= tree.params.tolerance {
-                // On the surface, counted as inside (see the module docs).
-                (vertex, value, on_surface) = (p, v.min(-f32::MIN_POSITIVE), true);
-            }
-        }
-        if linear && !on_surface {
-            // Move the vertex a quarter cell into the solid along the gradient.
-            let h = (hi - lo).max_element();
-            let g =
-                field.gradient(vertex).unwrap_or_else(|| finite_difference_gradient(field, vertex, h * 1e-3));
-            let slope = g.length();
-            if slope > 1e-12 {
-                let target = -0.25 * h * slope;
-                vertex = (vertex - g * ((value - target) / (slope * slope))).clamp(lo, hi);
-                value = field.value(vertex) - iso;
-            }
-        }
-        if !on_surface {
-            value = snap_noise(field, vertex, value, tree.size, node.inside);
-        }
+        let (vertex, value, on_surface) = if node.centred && !node.keep_sign {
+            let (vertex, value) = centred_vertex(tree, field, CellRef { node: n, clamp: 0 });
+            (vertex, value, false)
+        } else if node.centred {
+            let (vertex, value, _) = free_vertex(tree, field, n, false);
+            let (lo, hi) = shrunk(tree, n);
+            let (vertex, value) =
+                toward_centre(field, tree.params.iso, vertex, value, (lo + hi) * 0.5, tree.size, node.inside);
+            (vertex, value, false)
+        } else {
+            free_vertex(tree, field, n, sliver_elimination && !node.keep_free)
+        };
         let node = &mut tree.nodes[n as usize];
         node.vertex = vertex;
         node.value = value;
         node.has_vertex = true;
         node.on_surface = on_surface;
     }
+}
+
+/// The vertex of sampled leaf `n` as feature isolation places it when not centred: position,
+/// `f - iso` (its sign by the rules in the module docs), and whether sliver elimination (when
+/// `on_surface_allowed`) put it on the surface.
+fn free_vertex(tree: &Octree, field: &dyn Field, n: u32, on_surface_allowed: bool) -> (Vec3, f32, bool) {
+    let node = &tree.nodes[n as usize];
+    let iso = tree.params.iso;
+    let (lo, hi) = shrunk(tree, n);
+    let linear = node.straddles && node.rank == 1;
+    let mut vertex = free_minimiser(tree, n, lo, hi);
+    let mut value = field.value(vertex) - iso;
+    if on_surface_allowed && linear {
+        let restricted = tree.qefs[node.qef as usize].minimise_in_box(lo, hi, Some(0.0));
+        let p = restricted.position.as_vec3();
+        let v = field.value(p) - iso;
+        if restricted.rms <= tree.params.tolerance as f64 && v.abs() <= tree.params.tolerance {
+            // On the surface, counted as inside (see the module docs).
+            return (p, v.min(-f32::MIN_POSITIVE), true);
+        }
+    }
+    if linear {
+        // Move the vertex a quarter cell into the solid along the gradient.
+        let h = (hi - lo).max_element();
+        let g = field.gradient(vertex).unwrap_or_else(|| finite_difference_gradient(field, vertex, h * 1e-3));
+        let slope = g.length();
+        if slope > 1e-12 {
+            let target = -0.25 * h * slope;
+            vertex = (vertex - g * ((value - target) / (slope * slope))).clamp(lo, hi);
+            value = field.value(vertex) - iso;
+        }
+    }
+    (vertex, snap_noise(field, vertex, value, tree.size, node.inside), false)
+}
+
+/// The value (`f - iso`) of the vertex of `r` (a sampled leaf or its boundary copy) as it would be
+/// without centring: what a centred vertex that keeps its sign keeps the sign of.
+pub fn uncentred_value(tree: &Octree, field: &dyn Field, r: CellRef) -> f32 {
+    if r.clamp == 0 {
+        return free_vertex(tree, field, r.node, false).1;
+    }
+    let (lo, hi) = vertex_box(tree, r);
+    let p = free_minimiser(tree, r.node, lo, hi);
+    snap_noise(field, p, field.value(p) - tree.params.iso, tree.size, tree.nodes[r.node as usize].inside)
 }
 
 /// Leaves whose vertex sliver elimination moved onto the surface but which share a mixed dual
@@ -167,8 +188,9 @@ impl DualVertices {
     }
 }
 
-/// The vertex of a leaf's face, edge or corner on the root's boundary.
-fn boundary_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) {
+/// The box a vertex of `r` is kept in: the leaf shrunk by [`SHRINK`], flattened onto the root's
+/// boundary where `r` is clamped.
+fn vertex_box(tree: &Octree, r: CellRef) -> (Vec3, Vec3) {
     let (cell_lo, cell_hi) = tree.cell(r.node);
     let (mut lo, mut hi) = shrunk(tree, r.node);
     for a in 0..3 {
@@ -180,13 +202,35 @@ fn boundary_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) 
         lo[a] = pinned;
         hi[a] = pinned;
     }
+    (lo, hi)
+}
+
+/// The vertex of a leaf's face, edge or corner on the root's boundary.
+fn boundary_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) {
     let node = &tree.nodes[r.node as usize];
-    let p = match node.kind {
-        Kind::Pruned => (lo + hi) * 0.5,
-        _ if node.centred => (lo + hi) * 0.5,
-        _ => free_minimiser(tree, r.node, lo, hi),
-    };
-    (p, snap_noise(field, p, field.value(p) - tree.params.iso, tree.size, node.inside))
+    if node.kind == Kind::Pruned || (node.centred && !node.keep_sign) {
+        return centred_vertex(tree, field, r);
+    }
+    let (lo, hi) = vertex_box(tree, r);
+    let iso = tree.params.iso;
+    let p = free_minimiser(tree, r.node, lo, hi);
+    let value = snap_noise(field, p, field.value(p) - iso, tree.size, node.inside);
+    if node.centred {
+        return toward_centre(field, iso, p, value, (lo + hi) * 0.5, tree.size, node.inside);
+    }
+    (p, value)
+}
+
+/// The vertex `r` gets when its leaf is centred (refinement rules 4 and 5) or pruned: the centre of
+/// its box, and `f - iso` there (a boundary vertex's sign by [`snap_noise`]).
+fn centred_vertex(tree: &Octree, field: &dyn Field, r: CellRef) -> (Vec3, f32) {
+    let (lo, hi) = vertex_box(tree, r);
+    let p = (lo + hi) * 0.5;
+    let value = field.value(p) - tree.params.iso;
+    if r.clamp == 0 {
+        return (p, value);
+    }
+    (p, snap_noise(field, p, value, tree.size, tree.nodes[r.node as usize].inside))
 }
 
 /// Distance from the iso-level (as a fraction of the root's side) below which a vertex's value is
@@ -221,5 +265,43 @@ fn snap_noise(field: &dyn Field, p: Vec3, value: f32, root_size: f32, inside: bo
         -f32::MIN_POSITIVE
     } else {
         0.0
+    }
+}
+
+/// The vertex of a centred leaf whose centre has the other sign than its free vertex (`value` at
+/// `free`) and where that sign change would change the contour's topology (see
+/// [`super::refine::keep_signs`]): the point of the segment from `free` to `centre` halfway to the
+/// first sign change along it (found by bisection), so the vertex moves toward the centre but keeps
+/// its side.
+fn toward_centre(
+    field: &dyn Field,
+    iso: f32,
+    free: Vec3,
+    value: f32,
+    centre: Vec3,
+    root_size: f32,
+    inside: bool,
+) -> (Vec3, f32) {
+    let side = value < 0.0;
+    let at = |t: f32| {
+        let p = free + (centre - free) * t;
+        (p, snap_noise(field, p, field.value(p) - iso, root_size, inside))
+    };
+    let (p, v) = at(1.0);
+    if (v < 0.0) == side {
+        return (p, v);
+    }
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..24 {
+        let mid = 0.5 * (lo + hi);
+        if (at(mid).1 < 0.0) == side {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    match at(0.5 * lo) {
+        (p, v) if (v < 0.0) == side => (p, v),
+        _ => (free, value),
     }
 }

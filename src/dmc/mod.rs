@@ -180,10 +180,19 @@ pub fn mesh_field(
         let t = Instant::now();
         let mut vertices = DualVertices::new(&tree);
         let (mut refs, mut ids): (Vec<[CellRef; 8]>, Vec<[u32; 8]>) = (Vec::new(), Vec::new());
+        // The dual cells around centred leaves not checked yet by `refine::keep_signs`.
+        let unchecked: Vec<bool> =
+            (0..tree.nodes.len() as u32).map(|n| refine::unchecked_centre(&tree, n)).collect();
+        let check = unchecked.contains(&true);
+        let (mut around, mut around_ids): (Vec<[CellRef; 8]>, Vec<[u32; 8]>) = (Vec::new(), Vec::new());
         stats.dual_cells = 0;
         dual::for_each_dual_cell(&tree, |cell| {
             stats.dual_cells += 1;
             let cell_ids = cell.map(|r| vertices.id(&tree, field, r));
+            if check && cell.iter().any(|r| unchecked[r.node as usize]) {
+                around.push(*cell);
+                around_ids.push(cell_ids);
+            }
             let first = vertices.values[cell_ids[0] as usize] < 0.0;
             if cell_ids.iter().any(|&v| (vertices.values[v as usize] < 0.0) != first) {
                 refs.push(*cell);
@@ -199,6 +208,13 @@ pub fn mesh_field(
         }
         stats.octree_ms += ms_since(t);
         if !unprune.is_empty() {
+            continue;
+        }
+        let t = Instant::now();
+        let kept =
+            check && refine::keep_signs(&mut tree, field, &vertices.values, &ids, &around, &around_ids);
+        stats.topology_ms += ms_since(t);
+        if kept {
             continue;
         }
         let revert = features::near_features(&tree, &refs);

@@ -64,6 +64,11 @@ pub struct Node {
     pub keep_free: bool,
     /// The vertex stays at the cell's centre: feature placement folded the contour here.
     pub centred: bool,
+    /// A centred vertex keeps the side of the iso-level its free vertex is on: at the centre that
+    /// side would change the contour's topology (see [`crate::dmc::refine::keep_signs`]).
+    pub keep_sign: bool,
+    /// [`crate::dmc::refine::keep_signs`] has decided `keep_sign`.
+    pub centre_checked: bool,
     /// The dual vertex (set by feature isolation) and `f - iso` there.
     pub vertex: Vec3,
     pub value: f32,
@@ -108,6 +113,8 @@ impl Node {
             on_surface: false,
             keep_free: false,
             centred: false,
+            keep_sign: false,
+            centre_checked: false,
             vertex: Vec3::ZERO,
             value: 0.0,
             has_vertex: false,

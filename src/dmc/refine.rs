@@ -25,13 +25,24 @@
 //!
 //! Rules 2 and 3 depend only on mixed dual cells and the contour, which rule 1 makes identical with
 //! and without pruning, so they refine the same leaves in both.
+//!
+//! Rules 4 and 5 (folds, intersections; see [`plan`] and [`untangle`]) fall back to the leaf's
+//! centre where no leaf can be split. A centre on the other side of the iso-level than the free
+//! vertex changes the signs Marching Cubes sees, and [`keep_signs`] keeps the free vertex's side
+//! wherever the centre would add a component or a handle (a hole through a thin wall). That check
+//! also looks at unmixed dual cells around the centred leaf; a pruned leaf there has one sign over
+//! its whole cell, as its unpruned subtree does, so it is expected to decide alike with and without
+//! pruning — tested on three scenes, not proved like rule 1.
 
 use super::contour::{triangle_error, Contour};
 use super::dual::CellRef;
+use super::features::uncentred_value;
 use super::memo::Memo;
 use super::octree::{Kind, Octree};
 use crate::field::{finite_difference_gradient, Field};
+use crate::tables::{triangle_table, EDGES};
 use glam::Vec3;
+use std::collections::HashMap;
 
 fn is_mixed(cell: &[u32; 8], values: &[f32]) -> bool {
     let first = values[cell[0] as usize] < 0.0;
@@ -174,4 +185,170 @@ pub fn untangle(tree: &Octree, refs: &[[CellRef; 8]], contour: &Contour, pairs: 
         plan.treat(tree, &refs[c as usize], true);
     }
     plan.finish()
+}
+
+/// Decides, once per centred leaf and in the first round its centre is used, whether its vertex
+/// keeps the side of the iso-level of its free vertex; returns whether any does (the round must be
+/// redone with those vertices).
+///
+/// Marching Cubes on the dual grid sees the surface only through the signs of the dual vertices,
+/// so moving a vertex to its cell's centre changes the contour's topology wherever the centre lies
+/// on the other side and the vertex was the only witness of its side there. A thin wall is the
+/// case: the free vertex of a leaf at the wall (or at the edge where two walls meet) sits on the
+/// wall's mid-surface, inside, and the leaf's centre lies outside the wall, so centring punches a
+/// hole through it (the planar room got three handles this way at depths 5 and 6). On a smooth
+/// surface the centre's side is harmless (the sheet passes on the other side of the vertex), and
+/// there centring can also remove a bubble that a vertex on the zero set made.
+///
+/// So a centring may take topology away but never add any. Starting from the signs without any of
+/// the centrings being decided, they are applied one at a time, in node order, each to the contour
+/// of the mixed dual cells and of every dual cell around the leaf's dual vertices (its own and its
+/// boundary copies, in `around`), built combinatorially as [`super::contour`] builds it. A centring
+/// is kept when the contour has no more components and no larger genus with it than without it;
+/// otherwise the leaf keeps its side ([`crate::dmc::octree::Node::keep_sign`]).
+pub fn keep_signs(
+    tree: &mut Octree,
+    field: &dyn Field,
+    values: &[f32],
+    mixed: &[[u32; 8]],
+    around: &[[CellRef; 8]],
+    around_ids: &[[u32; 8]],
+) -> bool {
+    let candidates: Vec<u32> = tree.leaves().filter(|&n| unchecked_centre(tree, n)).collect();
+    if candidates.is_empty() {
+        return false;
+    }
+    let mut cells: Vec<[u32; 8]> = mixed.to_vec();
+    cells.extend(around_ids.iter().filter(|c| !is_mixed(c, values)));
+    // Per candidate, its dual vertices whose free vertex is on the other side than the centre.
+    let mut flips: Vec<(u32, Vec<(u32, f32)>)> = Vec::new();
+    for n in candidates {
+        tree.nodes[n as usize].centre_checked = true;
+        let mut free: Vec<(u32, f32)> = Vec::new();
+        for (cell, cell_ids) in around.iter().zip(around_ids) {
+            for (r, &id) in cell.iter().zip(cell_ids) {
+                if r.node != n || free.iter().any(|&(f, _)| f == id) {
+                    continue;
+                }
+                let v = uncentred_value(tree, field, *r);
+                if (v < 0.0) != (values[id as usize] < 0.0) {
+                    free.push((id, v));
+                }
+            }
+        }
+        if !free.is_empty() {
+            flips.push((n, free));
+        }
+    }
+    if flips.is_empty() {
+        return false;
+    }
+    // From the signs without these centrings, each is applied in turn if it adds no topology.
+    let mut signs: HashMap<u32, bool> =
+        flips.iter().flat_map(|(_, free)| free.iter().map(|&(id, v)| (id, v < 0.0))).collect();
+    let negative =
+        |signs: &HashMap<u32, bool>, id: u32| signs.get(&id).copied().unwrap_or(values[id as usize] < 0.0);
+    let mut without = contour_topology(&cells, |id| negative(&signs, id));
+    let mut any = false;
+    for (n, free) in flips {
+        let with = contour_topology(&cells, |id| match free.iter().any(|&(f, _)| f == id) {
+            true => values[id as usize] < 0.0,
+            false => negative(&signs, id),
+        });
+        if with.components <= without.components && with.twice_genus() <= without.twice_genus() {
+            for &(id, _) in &free {
+                signs.insert(id, values[id as usize] < 0.0);
+            }
+            without = with;
+        } else {
+            let node = &mut tree.nodes[n as usize];
+            node.keep_sign = true;
+            node.has_vertex = false;
+            any = true;
+        }
+    }
+    any
+}
+
+/// A centred leaf whose centring [`keep_signs`] has not looked at yet.
+pub fn unchecked_centre(tree: &Octree, n: u32) -> bool {
+    let node = &tree.nodes[n as usize];
+    node.kind == Kind::Leaf && node.centred && !node.centre_checked
+}
+
+/// The topology of a contour: Euler characteristic, components, boundary loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Topology {
+    euler: i64,
+    components: i64,
+    boundary_loops: i64,
+}
+
+impl Topology {
+    fn twice_genus(&self) -> i64 {
+        2 * self.components - self.euler - self.boundary_loops
+    }
+}
+
+/// The contour of `cells` (dual vertex ids in octant order) with the signs `negative`, as Marching
+/// Cubes in [`super::contour`] builds it (mesh vertices named by their dual edge, triangles with a
+/// repeated vertex dropped), reduced to its topology.
+fn contour_topology(cells: &[[u32; 8]], negative: impl Fn(u32) -> bool) -> Topology {
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    fn join(parent: &mut [usize], a: usize, b: usize) {
+        let (ra, rb) = (root(parent, a), root(parent, b));
+        parent[ra] = rb;
+    }
+    let table = triangle_table();
+    let mut keys: HashMap<(u32, u32), usize> = HashMap::new();
+    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut faces = 0i64;
+    let mut parent: Vec<usize> = Vec::new();
+    for ids in cells {
+        let mut case = 0u8;
+        for (corner, &id) in ids.iter().enumerate() {
+            case |= (negative(id) as u8) << corner;
+        }
+        for t in table[case as usize].triangles() {
+            let k = t.map(|e| {
+                let [a, b] = EDGES[e as usize].map(|corner| ids[corner as usize]);
+                (a.min(b), a.max(b))
+            });
+            if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
+                continue;
+            }
+            faces += 1;
+            let v = k.map(|key| {
+                let next = keys.len();
+                let i = *keys.entry(key).or_insert(next);
+                if i == parent.len() {
+                    parent.push(i);
+                }
+                i
+            });
+            for j in 0..3 {
+                let (a, b) = (v[j], v[(j + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+                join(&mut parent, a, b);
+            }
+        }
+    }
+    let components = (0..parent.len()).filter(|&i| root(&mut parent, i) == i).count() as i64;
+    // Boundary loops: components of the graph of edges used by one triangle.
+    let mut loops: Vec<usize> = (0..parent.len()).collect();
+    let mut on_boundary = vec![false; parent.len()];
+    for (&(a, b), _) in edges.iter().filter(|&(_, &uses)| uses == 1) {
+        join(&mut loops, a, b);
+        on_boundary[a] = true;
+        on_boundary[b] = true;
+    }
+    let boundary_loops =
+        (0..loops.len()).filter(|&i| on_boundary[i] && root(&mut loops, i) == i).count() as i64;
+    Topology { euler: keys.len() as i64 - edges.len() as i64 + faces, components, boundary_loops }
 }
