@@ -151,7 +151,8 @@ fn fandisk_is_sharper_and_closer_than_mc() {
         let (off, worst) = fandisk_feature_offsets(&c);
         let within = off.iter().filter(|&&d| d < 0.01).count();
         // The part's creases form one connected graph. At 64 cells the feature lines break into
-        // 10 pieces where the top/side crease runs 1 % of a cell above a grid plane (z = 41):
+        // 10 pieces, most of the gaps where the top/side crease runs 1 % of a cell above a grid
+        // plane (z = 41):
         // cells below it see a sliver of the top, and their centres are approximate. Those bridge
         // the gaps.
         let (lines, bridged) = (feature_line_components(&c.emc), fan_centre_line_components(&c.emc, &c.grid));
