@@ -83,6 +83,9 @@ pub struct Request {
     /// EMC: triangulate components without a feature point by MCQ's per-cell rules
     /// (`mcq_rules`) instead of MC's table.
     pub better_triangles: bool,
+    /// EMC: move feature points onto curved creases by resampling their sheets (functions only);
+    /// `false` keeps the paper's tangent-plane points.
+    pub resample_creases: bool,
     /// MCQ: the per-cell rules, the snapping distance in cells (`None`: no snapping) and whether
     /// inserted vertices are projected onto the surface.
     pub mcq_rules: PolygonRules,
@@ -117,6 +120,7 @@ impl Default for Request {
             phi_corner: 0.7,
             directed: true,
             better_triangles: false,
+            resample_creases: true,
             mcq_rules: PolygonRules::default(),
             mcq_snap: Some(mcq::DEFAULT_SNAP),
             mcq_project: true,
@@ -178,7 +182,7 @@ impl Request {
             flip_edges: true,
             crust: true,
             better_triangles: self.better_triangles.then_some(self.mcq_rules),
-            resample_creases: true,
+            resample_creases: self.resample_creases,
             topology: self.topology,
             max_cells: self.max_cells,
         }

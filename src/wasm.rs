@@ -74,6 +74,11 @@ export interface MeshOptions {
    * Marching Cubes' table (default false); feature fans are unchanged. See the README's measurements.
    */
   betterTriangles?: boolean;
+  /**
+   * EMC: move feature points onto curved creases by sampling each sheet again next to the crease
+   * (default true; expressions and CSG only). false keeps the paper's tangent-plane points.
+   */
+  resampleCreases?: boolean;
   /** DMC: error tolerance as a fraction of the bounds' longest side (default 0.001). */
   tolerance?: number;
   /** DMC: deepest octree level (default: the depth whose finest cells match res). */
@@ -212,6 +217,7 @@ struct JsOptions {
     phi_corner: Option<f32>,
     directed: Option<bool>,
     better_triangles: Option<bool>,
+    resample_creases: Option<bool>,
     tolerance: Option<f32>,
     max_depth: Option<f64>,
     samples_per_cell: Option<f64>,
@@ -287,6 +293,7 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool)
     r.phi_corner = o.phi_corner.unwrap_or(r.phi_corner);
     r.directed = o.directed.unwrap_or(r.directed);
     r.better_triangles = o.better_triangles.unwrap_or(r.better_triangles);
+    r.resample_creases = o.resample_creases.unwrap_or(r.resample_creases);
     r.tolerance = o.tolerance.unwrap_or(r.tolerance);
     let whole = |name: &str, v: f64, max: f64| {
         if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= max {

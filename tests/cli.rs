@@ -239,6 +239,16 @@ fn dmc_reports_its_octree_and_phases() {
 }
 
 #[test]
+fn tangent_planes_keep_the_papers_feature_points_on_curved_creases() {
+    let args = ["mesh", "--scene", "fandisk", "--method", "emc", "--res", "32", "--no-intersections"];
+    let resampled = stats(&args);
+    let paper = stats(&[&args[..], &["--tangent-planes"]].concat());
+    assert!(resampled["closed_manifold"] == true && paper["closed_manifold"] == true, "{resampled} {paper}");
+    let dist = |s: &Value| s["dist_max"].as_f64().unwrap();
+    assert!(dist(&resampled) < dist(&paper), "{} against {}", dist(&resampled), dist(&paper));
+}
+
+#[test]
 fn triangle_meshes_of_every_format_are_remeshed() {
     for ext in ["obj", "stl", "ply"] {
         let input = scratch(&format!("box_in.{ext}"));

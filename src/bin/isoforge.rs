@@ -112,6 +112,10 @@ struct MeshArgs {
     /// --quad-ratio) instead of Marching Cubes' table; feature fans stay as they are.
     #[arg(long)]
     better_triangles: bool,
+    /// EMC: keep the paper's tangent-plane feature points on curved creases instead of resampling
+    /// each sheet next to the crease (expressions, CSG and scenes only).
+    #[arg(long)]
+    tangent_planes: bool,
     /// DMC: error tolerance as a fraction of the bounds' longest side (QEF residual and triangle
     /// distance to the surface).
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().tolerance)]
@@ -197,6 +201,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
         better_triangles: args.better_triangles,
+        resample_creases: !args.tangent_planes,
         mcq_rules: PolygonRules {
             cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
             quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),

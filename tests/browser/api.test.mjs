@@ -141,10 +141,13 @@ test('EMC options are passed through and feature edges come back', async () => {
       try { m.meshScene('sphere', { res: 8, ...o }); errors.push(null); } catch (e) { errors.push(e.message); }
     }
     const f = emc.featureEdges;
+    // Resampled creases (the default) against the paper's tangent-plane points on curved creases.
+    const resampled = m.meshScene('fandisk', { method: 'emc', res: 32 }).stats.dist_max;
+    const paper = m.meshScene('fandisk', { method: 'emc', res: 32, resampleCreases: false }).stats.dist_max;
     return {
       method: emc.stats.method, closed: emc.stats.closed_manifold, euler: emc.stats.euler,
       pairs: f.length / 2, even: f.length % 2 === 0, counted: emc.stats.feature_edges,
-      inRange: f.every((i) => i < emc.positions.length / 3), errors,
+      inRange: f.every((i) => i < emc.positions.length / 3), errors, resampled, paper,
     };
   });
   assert.equal(r.method, 'emc');
@@ -155,6 +158,7 @@ test('EMC options are passed through and feature edges come back', async () => {
   assert.match(r.errors[0], /thetaSharp/);
   assert.match(r.errors[1], /unknown method 'dc'/);
   assert.match(r.errors[2], /unknown field `thetaSharpe`, expected one of .*`thetaSharp`/);
+  assert.ok(r.resampled < r.paper, `resampled creases ${r.resampled} against tangent planes ${r.paper}`);
 });
 
 test('mcq meshes through the same options and snapping can be turned off', async () => {
