@@ -112,9 +112,10 @@ fn third_sheet(nrm: &[Vec3], na: Vec3, nb: Vec3) -> usize {
 /// The feature point of a sharp component, resampled ([`resample_feature`]), and what it is. An
 /// edge component with a crossing whose normal is sharp (below `theta_sharp`) against both of
 /// the edge's sheets has a third sheet: it is resampled as a corner first, kept when that works
-/// and lands within half a cell of the component's cell. The paper's corner test `φ` looks only at how far
-/// normals leave the plane of the two most different ones, and where the fandisk's cylindrical
-/// top meets its chamfer and a side face the top's normal stays within it (|n·n*| = 0.67).
+/// and lands within half a cell of the component's cell. The paper's corner test `φ` looks only
+/// at how far normals leave the plane of the two most different ones, and where the fandisk's
+/// cylindrical top meets its chamfer and a side face the top's normal stays within it
+/// (|n·n*| = 0.67).
 pub fn resample_component(
     solved: Vec3,
     kind: FeatureKind,
