@@ -101,6 +101,8 @@ pub struct Request {
     pub max_depth: Option<u8>,
     /// DMC: QEF samples per cell along each axis.
     pub samples_per_cell: usize,
+    /// DMC: the paper's refinement only (see [`DmcOptions::paper_only`]).
+    pub paper_only: bool,
 }
 
 impl Default for Request {
@@ -125,6 +127,7 @@ impl Default for Request {
             tolerance: DmcOptions::default().tolerance,
             max_depth: None,
             samples_per_cell: DmcOptions::default().samples_per_cell,
+            paper_only: false,
         }
     }
 }
@@ -141,6 +144,7 @@ impl Request {
             max_depth: self.depth(),
             samples_per_cell: self.samples_per_cell,
             max_cells: self.max_cells,
+            paper_only: self.paper_only,
             ..DmcOptions::default()
         }
     }

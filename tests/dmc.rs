@@ -170,6 +170,33 @@ fn planar_thin_room_keeps_genus_0_where_its_cells_are_wider_than_the_walls() {
     }
 }
 
+/// The paper's algorithm alone on the planar room (`paper_only`: the octree split by QEF residual,
+/// no accuracy, fold or intersection rule, no centring) comes close to the paper's count: one
+/// closed surface of genus 0 in ~1.05 K triangles at depth 5 and ~1.7 K at depth 6 (within 1 % of
+/// the room there), but its two wall sheets cross each other in hundreds of triangle pairs. Those
+/// crossings, and triangles cutting the room's inner edges, are what rules 3 to 5 split away, at
+/// 6 to 8 times the triangles (see the README, "Thin walls").
+#[test]
+fn planar_thin_room_with_the_papers_rule_alone_is_small_but_self_intersecting() {
+    let field = expr::compile(PLANAR_ROOM).unwrap();
+    let (min, max) = (Vec3::new(-1.0, -1.0, -0.7), Vec3::new(1.0, 1.0, 0.7));
+    let room = 1.6;
+    for (depth, most, error_below) in [(5, 1_100, 0.0125 * room), (6, 1_800, 0.01 * room)] {
+        let options = DmcOptions { max_depth: depth, paper_only: true, ..DmcOptions::default() };
+        let (mesh, _) = dmc_mesh(&field, min, max, &options);
+        let what = format!("paper-only planar room depth {depth}");
+        let topo = analysis::topology(&mesh);
+        assert!(topo.is_closed_manifold(), "{what}: {topo:?}");
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        let tris = mesh.triangle_count();
+        assert!(tris < most, "{what}: {tris} triangles");
+        let error = analysis::surface_error(&mesh, &field);
+        assert!(error.dist_max < error_below, "{what}: max distance {}", error.dist_max);
+        let crossings = analysis::self_intersections(&mesh);
+        assert!(crossings > 100, "{what}: {crossings} self-intersections (expected the sheets to cross)");
+    }
+}
+
 /// The generalised winding number of a closed mesh around `p` (solid angles, Van Oosterom and
 /// Strackee): 1 inside an outward-oriented closed surface, 0 outside.
 fn winding_number(mesh: &Mesh, p: Vec3) -> f64 {

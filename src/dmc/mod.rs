@@ -65,6 +65,11 @@ pub struct DmcOptions {
     pub prune: bool,
     /// Refuse octrees with more leaves than this.
     pub max_cells: u64,
+    /// The paper's refinement only, for measurement: the octree is split by QEF residual alone
+    /// (plus un-pruning and representing straddling leaves, `refine` rules 1 and 2); the accuracy,
+    /// fold and self-intersection rules (3 to 5) and the centring fallback are off. The result may
+    /// fold or self-intersect.
+    pub paper_only: bool,
 }
 
 impl Default for DmcOptions {
@@ -80,6 +85,7 @@ impl Default for DmcOptions {
             sliver_elimination: true,
             prune: true,
             max_cells: DEFAULT_MAX_CELLS,
+            paper_only: false,
         }
     }
 }
@@ -224,7 +230,10 @@ pub fn mesh_field(
         stats.contour_ms += ms_since(t);
 
         let t = Instant::now();
-        let plan = refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour, &mut memo);
+        let plan = match options.paper_only {
+            true => refine::represent(&tree, &refs, &ids, &vertices.values),
+            false => refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour, &mut memo),
+        };
         for &n in &revert {
             let node = &mut tree.nodes[n as usize];
             node.keep_free = true;
@@ -239,7 +248,10 @@ pub fn mesh_field(
         let t = Instant::now();
         let (contour, pairs) = finish(contour, &vertices, field, options, params.tolerance, &mut stats);
         stats.contour_ms += ms_since(t);
-        let plan = refine::untangle(&tree, &refs, &contour, &pairs);
+        let plan = match options.paper_only {
+            true => refine::Plan::default(),
+            false => refine::untangle(&tree, &refs, &contour, &pairs),
+        };
         if !apply(&mut tree, field, &plan)? {
             break contour;
         }
