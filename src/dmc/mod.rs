@@ -290,6 +290,8 @@ fn finish(
     tolerance: f32,
     stats: &mut DmcStats,
 ) -> (contour::Contour, Vec<[u32; 2]>) {
+    let mut contour = contour;
+    slivers::flip_caps(&mut contour);
     let intersections = |c: &contour::Contour| crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
     if !options.sliver_elimination {
         let pairs = intersections(&contour);
@@ -300,6 +302,7 @@ fn finish(
         let mut collapsed = contour.clone();
         let (removed, merged) =
             slivers::collapse(&mut collapsed, vertices, field, options.iso, tolerance, &skip);
+        slivers::flip_caps(&mut collapsed);
         let pairs = intersections(&collapsed);
         let culprits: Vec<u32> = pairs
             .iter()
