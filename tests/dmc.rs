@@ -173,11 +173,11 @@ fn planar_thin_room_keeps_genus_0_where_its_cells_are_wider_than_the_walls() {
 /// The paper's algorithm alone on the planar room (`paper_only`: the octree split by QEF residual,
 /// no accuracy, fold or intersection rule, no centring) comes close to the paper's count: one
 /// closed surface of genus 0 in ~1.05 K triangles at depth 5 and ~1.7 K at depth 6 (within 1 % of
-/// the room there), but not intersection-free: 64 / 71 pairs of triangles touch without sharing
-/// an edge or vertex, mostly along the room's inner (concave) edges and corners, where many
-/// crossings land exactly on the edge (202 / 379 before zero-area caps were flipped away, see
-/// `slivers::flip_caps`). Rules 3 to 5 split those places to the maximum depth (see the README,
-/// "Thin walls").
+/// the room there), but not intersection-free: 43 / 50 pairs of triangles overlap, coplanar
+/// triangles of a wall folded over each other in coarse dual cells (202 / 379 before zero-area
+/// caps and zero-length edges on the inner edges were removed, see `slivers::flip_caps`). Rules 3
+/// to 5 split those places, and the triangles cutting the inner edges, to the maximum depth (see
+/// the README, "Thin walls").
 #[test]
 fn planar_thin_room_with_the_papers_rule_alone_is_small_but_self_intersecting() {
     let field = expr::compile(PLANAR_ROOM).unwrap();
@@ -200,8 +200,9 @@ fn planar_thin_room_with_the_papers_rule_alone_is_small_but_self_intersecting() 
 }
 
 /// At depth 7 the planar room is intersection-free with < 9 500 triangles within 0.16 % of the
-/// room (9 250, max distance 0.0018; it was 21.6 K and 0.0053 before zero-area caps along the
-/// inner edges were flipped away instead of being split to the maximum depth by rule 5).
+/// room (8 938, max distance 0.0018; it was 21.6 K and 0.0053 before zero-area caps and
+/// zero-length edges along the inner edges were removed instead of being split to the maximum
+/// depth by rule 5).
 #[test]
 fn planar_thin_room_at_depth_7_is_accurate_with_fewer_triangles_than_at_depth_6() {
     let field = expr::compile(PLANAR_ROOM).unwrap();

@@ -291,6 +291,7 @@ fn finish(
     stats: &mut DmcStats,
 ) -> (contour::Contour, Vec<[u32; 2]>) {
     let mut contour = contour;
+    slivers::collapse_zero_edges(&mut contour);
     slivers::flip_caps(&mut contour);
     let intersections = |c: &contour::Contour| crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
     if !options.sliver_elimination {
@@ -302,6 +303,7 @@ fn finish(
         let mut collapsed = contour.clone();
         let (removed, merged) =
             slivers::collapse(&mut collapsed, vertices, field, options.iso, tolerance, &skip);
+        slivers::collapse_zero_edges(&mut collapsed);
         slivers::flip_caps(&mut collapsed);
         let pairs = intersections(&collapsed);
         let culprits: Vec<u32> = pairs

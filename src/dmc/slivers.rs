@@ -248,3 +248,62 @@ fn cap(mesh: &crate::mesh::Mesh, tri: [u32; 3]) -> Option<(u32, u32, u32)> {
     }
     None
 }
+
+/// Collapses edges of zero length (both ends at the same position: several crossings landing
+/// exactly on a corner of the surface) where the link condition allows it (the ends share exactly
+/// the two neighbours opposite the edge), dropping the two zero-area triangles beside the edge.
+/// Two triangles touching at such a point through different vertices counted as a
+/// self-intersection. Neither the surface nor its topology changes. Returns the number collapsed.
+pub fn collapse_zero_edges(contour: &mut Contour) -> usize {
+    use std::collections::HashSet;
+    let mut collapsed = 0;
+    loop {
+        let mesh = &contour.mesh;
+        let mut neighbours: Vec<HashSet<u32>> = vec![HashSet::new(); mesh.positions.len()];
+        for tri in &mesh.triangles {
+            for i in 0..3 {
+                let (u, v) = (tri[i], tri[(i + 1) % 3]);
+                neighbours[u as usize].insert(v);
+                neighbours[v as usize].insert(u);
+            }
+        }
+        let mut found = None;
+        'search: for tri in &mesh.triangles {
+            for i in 0..3 {
+                let (u, v) = (tri[i], tri[(i + 1) % 3]);
+                if u == v || mesh.positions[u as usize] != mesh.positions[v as usize] {
+                    continue;
+                }
+                let beside: Vec<u32> = mesh
+                    .triangles
+                    .iter()
+                    .filter(|t| t.contains(&u) && t.contains(&v))
+                    .map(|t| t.iter().copied().find(|&w| w != u && w != v).unwrap_or(u))
+                    .collect();
+                let common = neighbours[u as usize].intersection(&neighbours[v as usize]).count();
+                if beside.len() == 2 && beside[0] != beside[1] && common == 2 {
+                    found = Some((u, v));
+                    break 'search;
+                }
+            }
+        }
+        let Some((u, v)) = found else { break };
+        let mut t = 0;
+        while t < contour.mesh.triangles.len() {
+            let tri = &mut contour.mesh.triangles[t];
+            if tri.contains(&u) && tri.contains(&v) {
+                contour.mesh.triangles.swap_remove(t);
+                contour.cell_of_triangle.swap_remove(t);
+                continue;
+            }
+            for w in tri.iter_mut() {
+                if *w == v {
+                    *w = u;
+                }
+            }
+            t += 1;
+        }
+        collapsed += 1;
+    }
+    collapsed
+}
