@@ -126,6 +126,10 @@ struct MeshArgs {
     /// centring fallback off; the mesh may fold or self-intersect).
     #[arg(long)]
     paper_only: bool,
+    /// DMC: no refinement by the triangles' distance to the surface (rule 3); the QEF residual and
+    /// the fold and intersection rules still refine.
+    #[arg(long)]
+    no_accuracy_rule: bool,
     /// MCQ: merge vertices closer than this many cells to a grid point onto it (0: no snapping).
     #[arg(long, default_value_t = isoforge::mcq::DEFAULT_SNAP)]
     snap: f32,
@@ -215,6 +219,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         max_depth: args.max_depth,
         samples_per_cell: args.samples_per_cell,
         paper_only: args.paper_only,
+        accuracy_rule: !args.no_accuracy_rule,
         ..Request::default()
     };
     let out = mesh_input(&args, &request)?;

@@ -70,6 +70,11 @@ pub struct DmcOptions {
     /// fold and self-intersection rules (3 to 5) and the centring fallback are off. The result may
     /// fold or self-intersect.
     pub paper_only: bool,
+    /// Refinement rule 3 (split leaves under triangles farther from the surface than the
+    /// tolerance). Off, only the QEF residual and the fold and intersection rules refine: on the
+    /// planar room fewer triangles and, at depth 5, a smaller maximum distance (see the README,
+    /// "Thin walls"), but curved surfaces lose the accuracy bound.
+    pub accuracy_rule: bool,
 }
 
 impl Default for DmcOptions {
@@ -86,6 +91,7 @@ impl Default for DmcOptions {
             prune: true,
             max_cells: DEFAULT_MAX_CELLS,
             paper_only: false,
+            accuracy_rule: true,
         }
     }
 }
@@ -157,6 +163,7 @@ pub fn octree_root(min: Vec3, max: Vec3, options: &DmcOptions) -> (Vec3, f32, Pa
         samples_per_cell: options.samples_per_cell,
         prune: options.prune,
         max_leaves: options.max_cells,
+        accuracy_rule: options.accuracy_rule,
     };
     ((min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)
 }

@@ -163,7 +163,9 @@ pub fn plan(
         let normal = (b - a).cross(c - a);
         if mesh.triangles[t].iter().all(|&v| normal.dot(gradients[v as usize]) < 0.0) {
             folded.push(contour.cell_of_triangle[t]);
-        } else if memo.error([a, b, c], || triangle_error(mesh, t, field, tree.params.iso, h)) > tolerance {
+        } else if tree.params.accuracy_rule
+            && memo.error([a, b, c], || triangle_error(mesh, t, field, tree.params.iso, h)) > tolerance
+        {
             inaccurate.push(contour.cell_of_triangle[t]);
         }
     }
