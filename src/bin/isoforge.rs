@@ -126,6 +126,14 @@ struct MeshArgs {
     /// DMC: QEF samples per cell along each axis.
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().samples_per_cell)]
     samples_per_cell: usize,
+    /// DMC: refine by the QEF residual only, as the paper does (measurement: rules 3-5 and the
+    /// centring fallback off; the mesh may fold or self-intersect).
+    #[arg(long)]
+    paper_only: bool,
+    /// DMC: no refinement by the triangles' distance to the surface (rule 3); the QEF residual and
+    /// the fold and intersection rules still refine.
+    #[arg(long)]
+    no_accuracy_rule: bool,
     /// MCQ: merge vertices closer than this many cells to a grid point onto it (0: no snapping).
     #[arg(long, default_value_t = isoforge::mcq::DEFAULT_SNAP)]
     snap: f32,
@@ -215,6 +223,8 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         tolerance: args.tol,
         max_depth: args.max_depth,
         samples_per_cell: args.samples_per_cell,
+        paper_only: args.paper_only,
+        accuracy_rule: !args.no_accuracy_rule,
         ..Request::default()
     };
     let out = mesh_input(&args, &request)?;

@@ -212,6 +212,7 @@ mod tests {
             samples_per_cell: 3,
             prune: false,
             max_leaves: 1 << 20,
+            accuracy_rule: true,
         };
         Octree::build(&field, Vec3::splat(-1.0), 2.0, params).unwrap()
     }

@@ -65,6 +65,16 @@ pub struct DmcOptions {
     pub prune: bool,
     /// Refuse octrees with more leaves than this.
     pub max_cells: u64,
+    /// The paper's refinement only, for measurement: the octree is split by QEF residual alone
+    /// (plus un-pruning and representing straddling leaves, `refine` rules 1 and 2); the accuracy,
+    /// fold and self-intersection rules (3 to 5) and the centring fallback are off. The result may
+    /// fold or self-intersect.
+    pub paper_only: bool,
+    /// Refinement rule 3 (split leaves under triangles farther from the surface than the
+    /// tolerance). Off, only the QEF residual and the fold and intersection rules refine: on the
+    /// planar room fewer triangles and, at depth 5, a smaller maximum distance (see the README,
+    /// "Thin walls"), but curved surfaces lose the accuracy bound.
+    pub accuracy_rule: bool,
 }
 
 impl Default for DmcOptions {
@@ -80,6 +90,8 @@ impl Default for DmcOptions {
             sliver_elimination: true,
             prune: true,
             max_cells: DEFAULT_MAX_CELLS,
+            paper_only: false,
+            accuracy_rule: true,
         }
     }
 }
@@ -151,6 +163,7 @@ pub fn octree_root(min: Vec3, max: Vec3, options: &DmcOptions) -> (Vec3, f32, Pa
         samples_per_cell: options.samples_per_cell,
         prune: options.prune,
         max_leaves: options.max_cells,
+        accuracy_rule: options.accuracy_rule,
     };
     ((min + max) * 0.5 - Vec3::splat(size * ROOT_BELOW_CENTRE), size, params)
 }
@@ -224,7 +237,10 @@ pub fn mesh_field(
         stats.contour_ms += ms_since(t);
 
         let t = Instant::now();
-        let plan = refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour, &mut memo);
+        let plan = match options.paper_only {
+            true => refine::represent(&tree, &refs, &ids, &vertices.values),
+            false => refine::plan(&tree, field, &refs, &ids, &vertices.values, &contour, &mut memo),
+        };
         for &n in &revert {
             let node = &mut tree.nodes[n as usize];
             node.keep_free = true;
@@ -239,7 +255,10 @@ pub fn mesh_field(
         let t = Instant::now();
         let (contour, pairs) = finish(contour, &vertices, field, options, params.tolerance, &mut stats);
         stats.contour_ms += ms_since(t);
-        let plan = refine::untangle(&tree, &refs, &contour, &pairs);
+        let plan = match options.paper_only {
+            true => refine::Plan::default(),
+            false => refine::untangle(&tree, &refs, &contour, &pairs),
+        };
         if !apply(&mut tree, field, &plan)? {
             break contour;
         }
@@ -278,6 +297,9 @@ fn finish(
     tolerance: f32,
     stats: &mut DmcStats,
 ) -> (contour::Contour, Vec<[u32; 2]>) {
+    let mut contour = contour;
+    slivers::collapse_zero_edges(&mut contour);
+    slivers::flip_caps(&mut contour);
     let intersections = |c: &contour::Contour| crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
     if !options.sliver_elimination {
         let pairs = intersections(&contour);
@@ -288,6 +310,8 @@ fn finish(
         let mut collapsed = contour.clone();
         let (removed, merged) =
             slivers::collapse(&mut collapsed, vertices, field, options.iso, tolerance, &skip);
+        slivers::collapse_zero_edges(&mut collapsed);
+        slivers::flip_caps(&mut collapsed);
         let pairs = intersections(&collapsed);
         let culprits: Vec<u32> = pairs
             .iter()

@@ -84,6 +84,8 @@ pub struct Params {
     pub samples_per_cell: usize,
     pub prune: bool,
     pub max_leaves: u64,
+    /// Refinement rule 3 (see [`crate::dmc::refine`]) is applied.
+    pub accuracy_rule: bool,
 }
 
 pub struct Octree {
@@ -305,7 +307,15 @@ mod tests {
     use crate::expr::compile;
 
     fn params(prune: bool) -> Params {
-        Params { iso: 0.0, tolerance: 1e-3, max_depth: 5, samples_per_cell: 3, prune, max_leaves: 1 << 20 }
+        Params {
+            iso: 0.0,
+            tolerance: 1e-3,
+            max_depth: 5,
+            samples_per_cell: 3,
+            prune,
+            max_leaves: 1 << 20,
+            accuracy_rule: true,
+        }
     }
 
     #[test]

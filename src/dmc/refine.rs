@@ -111,6 +111,23 @@ fn splittable(tree: &Octree, n: u32) -> bool {
     tree.nodes[n as usize].kind == Kind::Leaf && tree.nodes[n as usize].depth < tree.params.max_depth
 }
 
+/// Rule 2 alone: the straddling sampled leaves in no mixed dual cell.
+pub fn represent(tree: &Octree, refs: &[[CellRef; 8]], ids: &[[u32; 8]], values: &[f32]) -> Plan {
+    let mut represented = vec![false; tree.nodes.len()];
+    for (r, cell) in refs.iter().zip(ids) {
+        if is_mixed(cell, values) {
+            for r in r {
+                represented[r.node as usize] = true;
+            }
+        }
+    }
+    let split = tree
+        .leaves()
+        .filter(|&n| splittable(tree, n) && tree.nodes[n as usize].straddles && !represented[n as usize])
+        .collect();
+    Plan { split, centre: Vec::new() }
+}
+
 /// Rules 2, 3 and 4 on a contour of the mixed dual cells `refs` (vertex ids `ids`); gradients and
 /// triangle errors measured in earlier rounds come from `memo`.
 ///
@@ -128,19 +145,7 @@ pub fn plan(
     contour: &Contour,
     memo: &mut Memo,
 ) -> Plan {
-    let mut plan = Plan::default();
-    let mut represented = vec![false; tree.nodes.len()];
-    for (r, cell) in refs.iter().zip(ids) {
-        if is_mixed(cell, values) {
-            for r in r {
-                represented[r.node as usize] = true;
-            }
-        }
-    }
-    plan.split
-        .extend(tree.leaves().filter(|&n| {
-            splittable(tree, n) && tree.nodes[n as usize].straddles && !represented[n as usize]
-        }));
+    let mut plan = represent(tree, refs, ids, values);
     let tolerance = tree.params.tolerance;
     let h = tree.cell_size(tree.params.max_depth) * 1e-2;
     let mesh = &contour.mesh;
@@ -158,7 +163,9 @@ pub fn plan(
         let normal = (b - a).cross(c - a);
         if mesh.triangles[t].iter().all(|&v| normal.dot(gradients[v as usize]) < 0.0) {
             folded.push(contour.cell_of_triangle[t]);
-        } else if memo.error([a, b, c], || triangle_error(mesh, t, field, tree.params.iso, h)) > tolerance {
+        } else if tree.params.accuracy_rule
+            && memo.error([a, b, c], || triangle_error(mesh, t, field, tree.params.iso, h)) > tolerance
+        {
             inaccurate.push(contour.cell_of_triangle[t]);
         }
     }

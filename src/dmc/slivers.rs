@@ -178,3 +178,132 @@ fn project(field: &dyn Field, iso: f32, mut p: Vec3, limit: f32) -> Vec3 {
     }
     p
 }
+
+/// Removes *caps*: triangles whose three corners are collinear, the middle one strictly between
+/// the other two (on the planar room many crossings land exactly on a concave edge of the wall,
+/// and Marching Cubes joins three of them). A cap's long edge is flipped with the neighbour across
+/// it: `(a, b, c)` with `b` on `a..c` and the neighbour `(c, a, d)` become `(a, b, d)` and
+/// `(b, c, d)`, which cover the neighbour exactly, so neither the surface nor its topology
+/// changes, but the zero-area triangle (which overlaps its neighbours along the line, counted as
+/// a self-intersection) is gone. A flip that would create an edge the mesh already has is skipped.
+/// Returns the number of flips.
+pub fn flip_caps(contour: &mut Contour) -> usize {
+    use std::collections::{HashMap, HashSet};
+    let mut flips = 0;
+    for _ in 0..16 {
+        let mesh = &contour.mesh;
+        let mut by_edge: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut edges: HashSet<(u32, u32)> = HashSet::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for i in 0..3 {
+                let (u, v) = (tri[i], tri[(i + 1) % 3]);
+                by_edge.insert((u, v), t);
+                edges.insert((u.min(v), u.max(v)));
+            }
+        }
+        let mut touched = vec![false; mesh.triangles.len()];
+        let mut todo: Vec<(usize, usize, [u32; 4])> = Vec::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let Some((a, b, c)) = cap(mesh, *tri) else { continue };
+            let Some(&n) = by_edge.get(&(a, c)) else { continue };
+            let d = mesh.triangles[n].into_iter().find(|&v| v != a && v != c).unwrap_or(a);
+            if n == t || touched[t] || touched[n] || d == a || d == b || edges.contains(&(b.min(d), b.max(d)))
+            {
+                continue;
+            }
+            touched[t] = true;
+            touched[n] = true;
+            edges.insert((b.min(d), b.max(d)));
+            todo.push((t, n, [a, b, c, d]));
+        }
+        if todo.is_empty() {
+            break;
+        }
+        for (t, n, [a, b, c, d]) in todo {
+            contour.mesh.triangles[t] = [a, b, d];
+            contour.mesh.triangles[n] = [b, c, d];
+            flips += 1;
+        }
+    }
+    flips
+}
+
+/// The corners of a cap triangle as `(a, b, c)` in the triangle's winding order with `b` the
+/// middle one (strictly between `a` and `c`, within 1e-5 of `|c - a|` of the line), or `None`.
+fn cap(mesh: &crate::mesh::Mesh, tri: [u32; 3]) -> Option<(u32, u32, u32)> {
+    for i in 0..3 {
+        let (a, b, c) = (tri[(i + 2) % 3], tri[i], tri[(i + 1) % 3]);
+        let (pa, pb, pc) =
+            (mesh.positions[a as usize], mesh.positions[b as usize], mesh.positions[c as usize]);
+        let ac = pc - pa;
+        let len2 = ac.length_squared();
+        if len2 == 0.0 {
+            return None;
+        }
+        let s = (pb - pa).dot(ac) / len2;
+        let off = (pb - pa - ac * s).length();
+        if s > 1e-3 && s < 1.0 - 1e-3 && off <= 1e-5 * len2.sqrt() {
+            return Some((a, b, c));
+        }
+    }
+    None
+}
+
+/// Collapses edges of zero length (both ends at the same position: several crossings landing
+/// exactly on a corner of the surface) where the link condition allows it (the ends share exactly
+/// the two neighbours opposite the edge), dropping the two zero-area triangles beside the edge.
+/// Two triangles touching at such a point through different vertices counted as a
+/// self-intersection. Neither the surface nor its topology changes. Returns the number collapsed.
+pub fn collapse_zero_edges(contour: &mut Contour) -> usize {
+    use std::collections::HashSet;
+    let mut collapsed = 0;
+    loop {
+        let mesh = &contour.mesh;
+        let mut neighbours: Vec<HashSet<u32>> = vec![HashSet::new(); mesh.positions.len()];
+        for tri in &mesh.triangles {
+            for i in 0..3 {
+                let (u, v) = (tri[i], tri[(i + 1) % 3]);
+                neighbours[u as usize].insert(v);
+                neighbours[v as usize].insert(u);
+            }
+        }
+        let mut found = None;
+        'search: for tri in &mesh.triangles {
+            for i in 0..3 {
+                let (u, v) = (tri[i], tri[(i + 1) % 3]);
+                if u == v || mesh.positions[u as usize] != mesh.positions[v as usize] {
+                    continue;
+                }
+                let beside: Vec<u32> = mesh
+                    .triangles
+                    .iter()
+                    .filter(|t| t.contains(&u) && t.contains(&v))
+                    .map(|t| t.iter().copied().find(|&w| w != u && w != v).unwrap_or(u))
+                    .collect();
+                let common = neighbours[u as usize].intersection(&neighbours[v as usize]).count();
+                if beside.len() == 2 && beside[0] != beside[1] && common == 2 {
+                    found = Some((u, v));
+                    break 'search;
+                }
+            }
+        }
+        let Some((u, v)) = found else { break };
+        let mut t = 0;
+        while t < contour.mesh.triangles.len() {
+            let tri = &mut contour.mesh.triangles[t];
+            if tri.contains(&u) && tri.contains(&v) {
+                contour.mesh.triangles.swap_remove(t);
+                contour.cell_of_triangle.swap_remove(t);
+                continue;
+            }
+            for w in tri.iter_mut() {
+                if *w == v {
+                    *w = u;
+                }
+            }
+            t += 1;
+        }
+        collapsed += 1;
+    }
+    collapsed
+}
