@@ -308,10 +308,9 @@ fn extract(
                     let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        let reach = grid.spacing * placement::GROWTH;
-                        let near = (cell_min - reach, cell_max + reach);
-                        let (mut kind, mut solved) = feature::sharp_point(&pts, &nrm, kind, near);
                         let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max };
+                        let near = component.grown(placement::GROWTH);
+                        let (mut kind, mut solved) = feature::sharp_point(&pts, &nrm, kind, near);
                         if options.resample_creases {
                             let theta = options.theta_sharp;
                             if let Some(better) =

@@ -47,11 +47,24 @@ pub struct Component<'a> {
     pub cell_max: Vec3,
 }
 
+impl Component<'_> {
+    /// The component's cell grown by `growth` cells on every side (shrunk where negative).
+    pub fn grown(&self, growth: f32) -> (Vec3, Vec3) {
+        let margin = (self.cell_max - self.cell_min) * growth;
+        (self.cell_min - margin, self.cell_max + margin)
+    }
+}
+
+/// Is `p` in the closed box `(lo, hi)`?
+pub fn contains((lo, hi): (Vec3, Vec3), p: Vec3) -> bool {
+    p.cmpge(lo).all() && p.cmple(hi).all()
+}
+
 /// Where a fan centre went.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
     pub position: Vec3,
-    /// On the solved feature (candidates 1 and 2): a feature vertex. Otherwise (3 and 4) only an
+    /// On the solved feature (candidates 1 and 2): a feature vertex. Otherwise (3 to 5) only an
     /// approximation that bends the patch toward it.
     pub on_feature: bool,
 }
@@ -65,7 +78,7 @@ pub struct Placement {
 pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
     let at = place_within(solved, kind, component, GROWTH)?;
     let p = at.position;
-    if p.cmpge(component.cell_min).all() && p.cmple(component.cell_max).all() {
+    if contains((component.cell_min, component.cell_max), p) {
         return Some(Placed { at, inside: None });
     }
     let inside = place_within(solved, kind, component, -INSET)?;
@@ -81,11 +94,8 @@ pub struct Placed {
 
 fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: f32) -> Option<Placement> {
     let (pts, nrm) = (component.pts, component.nrm);
-    let spacing = component.cell_max - component.cell_min;
-    let inset = spacing * INSET;
-    let inner = (component.cell_min + inset, component.cell_max - inset);
-    let margin = spacing * growth;
-    let grown = (component.cell_min - margin, component.cell_max + margin);
+    let inner = component.grown(-INSET);
+    let grown = component.grown(growth);
     let valid = |c: Vec3| fan_is_valid(c, pts, nrm);
     let line = match kind {
         FeatureKind::Edge => crease_direction(nrm),
@@ -94,7 +104,7 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
     let in_box = |(lo, hi): (Vec3, Vec3)| match line {
         Some(dir) => line_in_box(solved, dir, lo, hi)
             .map(|(s0, s1)| (solved + dir * 0.0f32.clamp(s0, s1)).clamp(lo, hi)),
-        None => (solved.cmpge(lo).all() && solved.cmple(hi).all()).then_some(solved),
+        None => contains((lo, hi), solved).then_some(solved),
     };
     let on_crease = in_box(inner);
     let along = |bounds: (Vec3, Vec3)| match line {

@@ -11,7 +11,7 @@
 
 use super::edges::EdgeSampler;
 use super::feature::{feature_point, widest_pair_indices, FeatureKind};
-use super::placement::{Component, GROWTH};
+use super::placement::{contains, Component, GROWTH};
 use glam::Vec3;
 
 /// How far (in cells) into each sheet, from the solved point, the sheet is sampled again.
@@ -125,15 +125,14 @@ pub fn resample_component(
 ) -> Option<(FeatureKind, Vec3)> {
     let (pts, nrm) = (component.pts, component.nrm);
     let cell = (component.cell_max - component.cell_min).min_element();
-    let reach = (component.cell_max - component.cell_min) * GROWTH;
-    let near = (component.cell_min - reach, component.cell_max + reach);
+    let near = component.grown(GROWTH);
     if kind == FeatureKind::Edge {
         let (a, b) = widest_pair_indices(nrm)?;
         let third = nrm[third_sheet(nrm, nrm[a], nrm[b])];
         if third.dot(nrm[a]) < theta_sharp && third.dot(nrm[b]) < theta_sharp {
             let guess = feature_point(pts, nrm, FeatureKind::Corner);
             let corner = resample_feature(guess, FeatureKind::Corner, pts, nrm, sampler, cell)
-                .filter(|c| c.cmpge(near.0).all() && c.cmple(near.1).all());
+                .filter(|&c| contains(near, c));
             if let Some(corner) = corner {
                 return Some((FeatureKind::Corner, corner));
             }
