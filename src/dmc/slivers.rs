@@ -192,6 +192,10 @@ pub fn flip_caps(contour: &mut Contour) -> usize {
     let mut flips = 0;
     for _ in 0..16 {
         let mesh = &contour.mesh;
+        // Caps are rare: the edge maps below are built only when there is one.
+        if !mesh.triangles.iter().any(|&tri| cap(mesh, tri).is_some()) {
+            break;
+        }
         let mut by_edge: HashMap<(u32, u32), usize> = HashMap::new();
         let mut edges: HashSet<(u32, u32)> = HashSet::new();
         for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -259,6 +263,17 @@ pub fn collapse_zero_edges(contour: &mut Contour) -> usize {
     let mut collapsed = 0;
     loop {
         let mesh = &contour.mesh;
+        let is_zero = |u: u32, v: u32| u != v && mesh.positions[u as usize] == mesh.positions[v as usize];
+        let zero_edges: Vec<(u32, u32)> = mesh
+            .triangles
+            .iter()
+            .flat_map(|tri| (0..3).map(move |i| (tri[i], tri[(i + 1) % 3])))
+            .filter(|&(u, v)| is_zero(u, v))
+            .collect();
+        // Zero-length edges are rare: the neighbour sets below are built only when there is one.
+        if zero_edges.is_empty() {
+            break;
+        }
         let mut neighbours: Vec<HashSet<u32>> = vec![HashSet::new(); mesh.positions.len()];
         for tri in &mesh.triangles {
             for i in 0..3 {
@@ -267,26 +282,16 @@ pub fn collapse_zero_edges(contour: &mut Contour) -> usize {
                 neighbours[v as usize].insert(u);
             }
         }
-        let mut found = None;
-        'search: for tri in &mesh.triangles {
-            for i in 0..3 {
-                let (u, v) = (tri[i], tri[(i + 1) % 3]);
-                if u == v || mesh.positions[u as usize] != mesh.positions[v as usize] {
-                    continue;
-                }
-                let beside: Vec<u32> = mesh
-                    .triangles
-                    .iter()
-                    .filter(|t| t.contains(&u) && t.contains(&v))
-                    .map(|t| t.iter().copied().find(|&w| w != u && w != v).unwrap_or(u))
-                    .collect();
-                let common = neighbours[u as usize].intersection(&neighbours[v as usize]).count();
-                if beside.len() == 2 && beside[0] != beside[1] && common == 2 {
-                    found = Some((u, v));
-                    break 'search;
-                }
-            }
-        }
+        let found = zero_edges.into_iter().find(|&(u, v)| {
+            let beside: Vec<u32> = mesh
+                .triangles
+                .iter()
+                .filter(|t| t.contains(&u) && t.contains(&v))
+                .map(|t| t.iter().copied().find(|&w| w != u && w != v).unwrap_or(u))
+                .collect();
+            let common = neighbours[u as usize].intersection(&neighbours[v as usize]).count();
+            beside.len() == 2 && beside[0] != beside[1] && common == 2
+        });
         let Some((u, v)) = found else { break };
         let mut t = 0;
         while t < contour.mesh.triangles.len() {
