@@ -86,6 +86,8 @@ pub struct Request {
     /// EMC: move feature points onto curved creases by resampling their sheets (functions only);
     /// `false` keeps the paper's tangent-plane points.
     pub resample_creases: bool,
+    /// EMC: collapse one flat crossing into each fan centre (see [`crate::emc::merge`]).
+    pub merge_flat: bool,
     /// MCQ: the per-cell rules, the snapping distance in cells (`None`: no snapping) and whether
     /// inserted vertices are projected onto the surface.
     pub mcq_rules: PolygonRules,
@@ -126,6 +128,7 @@ impl Default for Request {
             directed: true,
             better_triangles: false,
             resample_creases: true,
+            merge_flat: true,
             mcq_rules: PolygonRules::default(),
             mcq_snap: Some(mcq::DEFAULT_SNAP),
             mcq_project: true,
@@ -192,6 +195,7 @@ impl Request {
             crust: true,
             better_triangles: self.better_triangles.then_some(self.mcq_rules),
             resample_creases: self.resample_creases,
+            merge_flat: self.merge_flat,
             topology: self.topology,
             max_cells: self.max_cells,
         }
@@ -215,8 +219,8 @@ struct Meshed {
     mesh: Mesh,
     feature_edges: Vec<[u32; 2]>,
     phases: Vec<(String, f64)>,
-    /// Edge features, corner features, approximate features, flips (EMC).
-    feature_counts: [usize; 4],
+    /// Edge features, corner features, approximate features, flips, flat merges (EMC).
+    feature_counts: [usize; 5],
     /// Points evaluated and grid points (EMC).
     evaluations: Option<(usize, usize)>,
     /// Octree leaves and dual cells (DMC).
@@ -231,7 +235,7 @@ impl Meshed {
             mesh,
             feature_edges: vec![],
             phases,
-            feature_counts: [0; 4],
+            feature_counts: [0; 5],
             evaluations: None,
             quads: vec![],
             quad_stages: vec![],
@@ -248,7 +252,13 @@ impl Meshed {
 
     fn from_emc(out: EmcMesh, timings: crate::emc::EmcTimings) -> Meshed {
         Meshed {
-            feature_counts: [out.edge_features, out.corner_features, out.approximate_features, out.flips],
+            feature_counts: [
+                out.edge_features,
+                out.corner_features,
+                out.approximate_features,
+                out.flips,
+                out.flat_merges,
+            ],
             evaluations: Some((out.points_evaluated, out.grid_points)),
             octree: None,
             phases: timings.phases(),

@@ -70,6 +70,8 @@ pub struct Stats {
     pub approximate_features: usize,
     /// Edges flipped to make feature lines explicit (EMC).
     pub flips: usize,
+    /// Crossings collapsed into feature points on flat faces (EMC).
+    pub flat_merges: usize,
     /// Grid points where the field was evaluated (EMC's crust skips the rest), and the grid's size.
     pub points_evaluated: Option<usize>,
     pub grid_points: Option<usize>,
@@ -86,13 +88,14 @@ impl Stats {
     pub(crate) fn set_feature_counts(
         &mut self,
         feature_edges: usize,
-        [edges, corners, approximate, flips]: [usize; 4],
+        [edges, corners, approximate, flips, flat_merges]: [usize; 5],
     ) {
         self.feature_edges = feature_edges;
         self.edge_features = edges;
         self.corner_features = corners;
         self.approximate_features = approximate;
         self.flips = flips;
+        self.flat_merges = flat_merges;
     }
 }
 

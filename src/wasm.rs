@@ -79,6 +79,11 @@ export interface MeshOptions {
    * (default true; expressions and CSG only). false keeps the paper's tangent-plane points.
    */
   resampleCreases?: boolean;
+  /**
+   * EMC: collapse, into each feature point, one neighbouring crossing whose triangles lie in one
+   * plane (default true): gives back the fans' extra triangles without moving the surface.
+   */
+  mergeFlat?: boolean;
   /** DMC: error tolerance as a fraction of the bounds' longest side (default 0.001). */
   tolerance?: number;
   /** DMC: deepest octree level (default: the depth whose finest cells match res). */
@@ -138,9 +143,10 @@ export interface MeshStats {
   phases_ms: Record<string, number>;
   ms_analysis: number;
   /** EMC: mesh edges on feature lines, cells with an edge / corner feature point, cells fanned
-   * around a point near (not on) their feature, edges flipped (0 for MC). */
+   * around a point near (not on) their feature, edges flipped, crossings collapsed into feature
+   * points on flat faces (0 for MC). */
   feature_edges: number; edge_features: number; corner_features: number; approximate_features: number;
-  flips: number;
+  flips: number; flat_merges: number;
   /** EMC: grid points evaluated and the grid's points (null for other methods). */
   points_evaluated: number | null; grid_points: number | null;
   /** DMC: leaves of the final octree and dual cells traversed (null for other methods). */
@@ -218,6 +224,7 @@ struct JsOptions {
     directed: Option<bool>,
     better_triangles: Option<bool>,
     resample_creases: Option<bool>,
+    merge_flat: Option<bool>,
     tolerance: Option<f32>,
     max_depth: Option<f64>,
     samples_per_cell: Option<f64>,
@@ -294,6 +301,7 @@ fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool)
     r.directed = o.directed.unwrap_or(r.directed);
     r.better_triangles = o.better_triangles.unwrap_or(r.better_triangles);
     r.resample_creases = o.resample_creases.unwrap_or(r.resample_creases);
+    r.merge_flat = o.merge_flat.unwrap_or(r.merge_flat);
     r.tolerance = o.tolerance.unwrap_or(r.tolerance);
     let whole = |name: &str, v: f64, max: f64| {
         if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= max {

@@ -249,6 +249,19 @@ fn tangent_planes_keep_the_papers_feature_points_on_curved_creases() {
 }
 
 #[test]
+fn no_flat_merge_keeps_every_fans_extra_triangles() {
+    let args = ["mesh", "--scene", "rotated_box", "--method", "emc", "--res", "24", "--no-intersections"];
+    let merged = stats(&args);
+    let kept = stats(&[&args[..], &["--no-flat-merge"]].concat());
+    let count = |s: &Value, key: &str| s[key].as_u64().unwrap();
+    assert_eq!(count(&kept, "flat_merges"), 0);
+    assert!(count(&merged, "flat_merges") > 0, "{merged}");
+    assert_eq!(count(&merged, "triangles") + 2 * count(&merged, "flat_merges"), count(&kept, "triangles"));
+    assert_eq!(merged["euler"], kept["euler"]);
+    assert_eq!(merged["feature_edges"], kept["feature_edges"]);
+}
+
+#[test]
 fn triangle_meshes_of_every_format_are_remeshed() {
     for ext in ["obj", "stl", "ply"] {
         let input = scratch(&format!("box_in.{ext}"));

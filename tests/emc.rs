@@ -91,8 +91,11 @@ fn cube_minus_sphere_is_sharper_and_closer_than_mc() {
     for res in [32, 64] {
         let c = compare(&field, res);
         let what = format!("cube_minus_sphere res {res}");
+        // Measured: 1.08x and 1.02x MC's triangles at 32 and 64 (1.30x and 1.12x with every fan's
+        // two extra triangles kept: this part is mostly crease at 32 cells); the floor is
+        // +20 %.
         let tris = c.emc.mesh.triangle_count() as f64 / c.mc_triangles as f64;
-        assert!(tris < 1.35, "{what}: {tris:.2}x MC's triangles");
+        assert!(tris < 1.2, "{what}: {tris:.2}x MC's triangles");
         let p95 = c.mc_error.normal_dev_deg_p95 / c.emc_error.normal_dev_deg_p95;
         let dist = c.mc_error.dist_max / c.emc_error.dist_max;
         eprintln!(
@@ -137,10 +140,12 @@ fn fandisk_is_sharper_and_closer_than_mc() {
             "{what}: triangles {tris:.3}x MC's, normal p95 {:.3}° vs MC {:.2}° ({p95:.1}x), distance max {:.2e} vs {:.2e} ({dist:.2}x), {} corners",
             c.emc_error.normal_dev_deg_p95, c.mc_error.normal_dev_deg_p95, c.emc_error.dist_max, c.mc_error.dist_max, c.emc.corner_features
         );
-        // Measured: 1.19x and 1.10x the triangles; 10.6x and 16.2x (p95); 7.6x and 4.0x (max
-        // distance) at res 32 and 64 (2.30x and 1.15x before blunt corners that pass the φ test as
-        // edges were solved as corners, the lattice search for a valid fan on the groove's rim,
-        // where the top face lies within 1 % of a cell of a grid plane, and resampled creases).
+        // Measured at res 32 and 64: 1.04x and 1.02x the triangles (1.19x and 1.10x without flat
+        // merges); 9.7x and 16.2x (p95; 10.6x at 32 without merges: the p95 is over faces, and the
+        // merges remove flat faces at 0°); 7.6x and 4.0x (max distance; 2.30x and 1.15x before
+        // blunt corners that pass the φ test as edges were solved as corners, the lattice search
+        // for a valid fan on the groove's rim, where the top face lies within 1 % of a cell of a
+        // grid plane, and resampled creases).
         assert!(tris < 1.2, "{what}: {tris:.2}x MC's triangles");
         assert!(p95 > 5.0, "{what}: normal deviation p95 only {p95:.2}x better");
         assert!(dist > 3.0, "{what}: max distance only {dist:.2}x better");

@@ -116,6 +116,10 @@ struct MeshArgs {
     /// each sheet next to the crease (expressions, CSG and scenes only).
     #[arg(long)]
     tangent_planes: bool,
+    /// EMC: keep every fan's two extra triangles instead of collapsing, into each feature point,
+    /// one neighbouring crossing whose triangles lie in one plane.
+    #[arg(long)]
+    no_flat_merge: bool,
     /// DMC: error tolerance as a fraction of the bounds' longest side (QEF residual and triangle
     /// distance to the surface).
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().tolerance)]
@@ -210,6 +214,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         directed: !args.no_directed,
         better_triangles: args.better_triangles,
         resample_creases: !args.tangent_planes,
+        merge_flat: !args.no_flat_merge,
         mcq_rules: PolygonRules {
             cut_angle_deg: args.cut_angle.unwrap_or(defaults.cut_angle_deg),
             quad_ratio: args.quad_ratio.unwrap_or(defaults.quad_ratio),

@@ -15,6 +15,7 @@ pub mod directed;
 pub mod edges;
 pub mod feature;
 pub mod flip;
+pub mod merge;
 pub mod mesh_source;
 pub mod placement;
 pub mod point_source;
@@ -65,6 +66,9 @@ pub struct EmcOptions {
     /// (see [`resample`]), where the input can be sampled off the grid edges (functions, with
     /// `directed`). `false` keeps the paper's tangent-plane point.
     pub resample_creases: bool,
+    /// Collapse one flat crossing into each fan centre (see [`merge`]): gives back the fans' two
+    /// extra triangles where a flat face meets the feature, without moving the surface.
+    pub merge_flat: bool,
 }
 
 impl Default for EmcOptions {
@@ -80,6 +84,7 @@ impl Default for EmcOptions {
             crust: true,
             better_triangles: None,
             resample_creases: true,
+            merge_flat: true,
         }
     }
 }
@@ -125,6 +130,8 @@ pub struct EmcMesh {
     /// Fan centres outside their cell moved back inside because their fan cut a neighbour's
     /// triangles (see [`untangle`]).
     pub pulled_back_features: usize,
+    /// Crossings collapsed into fan centres on flat faces (see [`merge`]).
+    pub flat_merges: usize,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -215,6 +222,14 @@ pub fn mesh_with_sampler(
     while pull_back(&mut out, grid, &mut outside) > 0 {
         out.mesh.triangles.clone_from(&unflipped);
         flip(&mut out);
+    }
+    if options.merge_flat {
+        out.flat_merges = merge::merge_flat_crossings(
+            &mut out.mesh,
+            &fan_centre,
+            &mut out.feature_vertex,
+            grid.cell_size(),
+        );
     }
     out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
     timings.flip_ms = ms_since(t2);

@@ -144,10 +144,14 @@ test('EMC options are passed through and feature edges come back', async () => {
     // Resampled creases (the default) against the paper's tangent-plane points on curved creases.
     const resampled = m.meshScene('fandisk', { method: 'emc', res: 32 }).stats.dist_max;
     const paper = m.meshScene('fandisk', { method: 'emc', res: 32, resampleCreases: false }).stats.dist_max;
+    // Flat merges (the default) against every fan's two extra triangles kept.
+    const kept = m.meshScene('rotated_box', { method: 'emc', res: 24, mergeFlat: false }).stats;
     return {
       method: emc.stats.method, closed: emc.stats.closed_manifold, euler: emc.stats.euler,
       pairs: f.length / 2, even: f.length % 2 === 0, counted: emc.stats.feature_edges,
       inRange: f.every((i) => i < emc.positions.length / 3), errors, resampled, paper,
+      merges: emc.stats.flat_merges, triangles: emc.stats.triangles, keptMerges: kept.flat_merges,
+      keptTriangles: kept.triangles,
     };
   });
   assert.equal(r.method, 'emc');
@@ -155,6 +159,9 @@ test('EMC options are passed through and feature edges come back', async () => {
   assert.equal(r.euler, 2);
   assert.ok(r.pairs > 0 && r.even && r.inRange);
   assert.equal(r.pairs, r.counted);
+  assert.ok(r.merges > 0, `${r.merges} flat merges`);
+  assert.equal(r.keptMerges, 0);
+  assert.equal(r.triangles + 2 * r.merges, r.keptTriangles);
   assert.match(r.errors[0], /thetaSharp/);
   assert.match(r.errors[1], /unknown method 'dc'/);
   assert.match(r.errors[2], /unknown field `thetaSharpe`, expected one of .*`thetaSharp`/);
