@@ -102,24 +102,26 @@ fn cube_minus_sphere_is_sharper_and_closer_than_mc() {
             "{what}: triangles {tris:.3}x MC's, normal p95 {:.3}° vs MC {:.2}° ({p95:.1}x), distance max {:.2e} vs {:.2e} ({dist:.2}x)",
             c.emc_error.normal_dev_deg_p95, c.mc_error.normal_dev_deg_p95, c.emc_error.dist_max, c.mc_error.dist_max
         );
-        // Measured: 29.2x and 36.8x (p95), 10.5x and 14.5x (max distance) at res 32 and 64; the
+        // Measured: 43.2x and 36.0x (p95), 15.8x and 14.5x (max distance) at res 32 and 64; the
         // issue's floors are 5x and 3x.
         assert!(p95 > 5.0, "{what}: normal deviation p95 only {p95:.2}x better");
         assert!(dist > 3.0, "{what}: max distance only {dist:.2}x better");
         // Eight cube corners are found as corners.
         assert_eq!(c.emc.corner_features, 8, "{what}");
-        // Every feature point lies on a crease: on two of the solid's surfaces at once. On the
-        // cube's straight edges within 1 % of a cell; on the circles where the ball cuts the faces
-        // (curved creases, where intersecting tangent planes errs by O(h²)) within a bound that
-        // shrinks faster than the cell.
-        let curved_bound = if res == 32 { 0.4 } else { 0.16 };
+        // Every feature point lies on a crease, on two of the solid's surfaces at once, within 1 %
+        // of a cell: the cube's straight edges and the circles where the ball cuts the faces
+        // (curved creases, where intersecting tangent planes alone errs by O(h²): 0.4 and 0.16
+        // cells before creases were resampled). Measured: at most 0.0093 cells, on the circles at
+        // 64.
         for (v, p) in c.emc.mesh.positions.iter().enumerate().filter(|(v, _)| c.emc.feature_vertex[*v]) {
             let planes = [(p.x.abs() - 0.6).abs(), (p.y.abs() - 0.6).abs(), (p.z.abs() - 0.6).abs()];
-            let ball = (p.length() - 0.75).abs();
-            let mut d = [(planes[0], false), (planes[1], false), (planes[2], false), (ball, true)];
-            d.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let (off, bound) = if d[0].1 || d[1].1 { (d[1].0, curved_bound) } else { (d[1].0, 0.01) };
-            assert!(off < bound * c.h, "{what}: feature vertex {v} at {p} is {off} from a crease");
+            let mut d = [planes[0], planes[1], planes[2], (p.length() - 0.75).abs()];
+            d.sort_by(f32::total_cmp);
+            assert!(
+                d[1] < 0.01 * c.h,
+                "{what}: feature vertex {v} at {p} is {} cells from a crease",
+                d[1] / c.h
+            );
         }
         // Feature lines: the cube's 12 edges joined at its corners, and the six circles where the
         // ball cuts the faces.
@@ -149,12 +151,13 @@ fn fandisk_is_sharper_and_closer_than_mc() {
         assert!(tris < 1.2, "{what}: {tris:.2}x MC's triangles");
         assert!(p95 > 5.0, "{what}: normal deviation p95 only {p95:.2}x better");
         assert!(dist > 3.0, "{what}: max distance only {dist:.2}x better");
-        // Feature points on the part's creases: on two of its primitive surfaces at once. Measured
-        // (with creases resampled): all 258 within 1 % of a cell at 32; at 64 all but 2 of 514,
-        // which lie 0.07 cells off where the chamfer/side edge ends in a corner under the top
-        // (an edge component that sees two of the three sheets; its line runs past the corner).
+        // Every feature point on the part's creases: on two of its primitive surfaces at once and
+        // on the part, within 1 % of a cell. Measured: all 258 and 512, worst 0.005 and 0.009
+        // cells. Two centres at 64 lie 0.07 cells off, where the chamfer/side edge ends in a
+        // corner under the top (an edge component that sees two of the three sheets; its line
+        // runs past the corner): the field says they are off the surface, so they are reported as
+        // approximate centres, not feature points.
         let (off, worst) = fandisk_feature_offsets(&c);
-        let within = off.iter().filter(|&&d| d < 0.01).count();
         // The part's creases form one connected graph. At 64 cells the feature lines break into
         // 10 pieces, most of the gaps where the top/side crease runs 1 % of a cell above a grid
         // plane (z = 41):
@@ -163,16 +166,9 @@ fn fandisk_is_sharper_and_closer_than_mc() {
         let (lines, bridged) = (feature_line_components(&c.emc), fan_centre_line_components(&c.emc, &c.grid));
         eprintln!("{what}: feature lines in {lines} pieces, {bridged} with approximate centres");
         assert_eq!(bridged, 1, "{what}: the creases' graph is one piece");
-        eprintln!(
-            "{what}: {within} of {} feature points within 1 % of a cell of a crease, worst {worst:.3} cells",
-            off.len()
-        );
-        assert!(
-            within as f64 >= 0.99 * off.len() as f64,
-            "{what}: only {within} of {} on a crease",
-            off.len()
-        );
-        assert!(worst < 0.1, "{what}: a feature point {worst:.3} cells off the creases");
+        eprintln!("{what}: {} feature points, worst {worst:.4} cells off a crease", off.len());
+        assert!(off.len() > 250, "{what}: only {} feature points", off.len());
+        assert!(worst < 0.01, "{what}: a feature point {worst:.4} cells off the creases");
     }
 }
 

@@ -20,6 +20,13 @@ pub trait EdgeSampler {
     fn crossing_on_segment(&self, _a: Vec3, _b: Vec3) -> Option<(f32, Vec3)> {
         None
     }
+
+    /// An estimate of the distance from any point `p` to the surface (first order, |f| / |∇f|);
+    /// `None` where the sampler cannot evaluate off its records. Checks that a feature point lies
+    /// on the surface.
+    fn distance(&self, _p: Vec3) -> Option<f32> {
+        None
+    }
 }
 
 /// Crossings of a field: exact by root finding (`directed`), or interpolated from the end values;
@@ -44,6 +51,17 @@ impl EdgeSampler for FieldRoots<'_> {
         }
         let (da, db) = (self.field.value(a) - self.iso, self.field.value(b) - self.iso);
         ((da < 0.0) != (db < 0.0) && da.is_finite() && db.is_finite()).then(|| self.crossing(a, b, da, db))
+    }
+
+    fn distance(&self, p: Vec3) -> Option<f32> {
+        if !self.directed {
+            return None;
+        }
+        let h = self.h * 1e-3;
+        let slope =
+            self.field.gradient(p).unwrap_or_else(|| finite_difference_gradient(self.field, p, h)).length();
+        let d = (self.field.value(p) - self.iso).abs() / slope;
+        (slope > 0.0 && d.is_finite()).then_some(d)
     }
 }
 

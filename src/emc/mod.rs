@@ -64,7 +64,9 @@ pub struct EmcOptions {
     pub better_triangles: Option<PolygonRules>,
     /// Move edge points onto curved creases by sampling each sheet again next to the solved point
     /// (see [`resample`]), where the input can be sampled off the grid edges (functions, with
-    /// `directed`). `false` keeps the paper's tangent-plane point.
+    /// `directed`). There, a feature point the field puts more than 1 % of a cell off the surface
+    /// is reported as an approximate centre (see [`placement::Placed::check_surface`]). `false`
+    /// keeps the paper's tangent-plane point.
     pub resample_creases: bool,
     /// Collapse one flat crossing into each fan centre (see [`merge`]): gives back the fans' two
     /// extra triangles where a flat face meets the feature, without moving the surface.
@@ -202,7 +204,7 @@ pub fn mesh_with_sampler(
     check_finite(values, grid)?;
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
-    let (mut out, fan_centre, outside) = extract(values, grid, options, sampler);
+    let (mut out, mut centres, outside) = extract(values, grid, options, sampler);
     out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
     let t2 = Instant::now();
@@ -213,20 +215,20 @@ pub fn mesh_with_sampler(
     // neighbouring fan centres takes the chord across a crease out of the mesh.
     let mut outside = outside;
     let unflipped = if outside.fans.is_empty() { Vec::new() } else { out.mesh.triangles.clone() };
-    let flip = |out: &mut EmcMesh| {
+    let flip = |out: &mut EmcMesh, centres: &FanCentres| {
         if options.flip_edges {
-            out.flips = flip::flip_toward_features(&mut out.mesh, &fan_centre, &out.feature_vertex);
+            out.flips = flip::flip_toward_features(&mut out.mesh, &centres.any, &centres.on_feature);
         }
     };
-    flip(&mut out);
-    while pull_back(&mut out, grid, &mut outside) > 0 {
+    flip(&mut out, &centres);
+    while pull_back(&mut out, &mut centres, grid, &mut outside) > 0 {
         out.mesh.triangles.clone_from(&unflipped);
-        flip(&mut out);
+        flip(&mut out, &centres);
     }
     if options.merge_flat {
         out.flat_merges = merge::merge_flat_crossings(
             &mut out.mesh,
-            &fan_centre,
+            &centres.any,
             &mut out.feature_vertex,
             grid.cell_size(),
         );
@@ -258,7 +260,7 @@ fn extract(
     grid: &Grid,
     options: &EmcOptions,
     sampler: &dyn EdgeSampler,
-) -> (EmcMesh, Vec<bool>, OutsideFans) {
+) -> (EmcMesh, FanCentres, OutsideFans) {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -272,8 +274,7 @@ fn extract(
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
     let mut cell_triangles = CellTriangleIndex::default();
     let mut outside_fans: Vec<OutsideFan> = Vec::new();
-    // Per vertex: is it the centre of a feature fan (on the feature or approximately)?
-    let mut fan_centre: Vec<bool> = Vec::new();
+    let mut centres = FanCentres::default();
 
     for k in 0..cz {
         if k > 0 {
@@ -313,7 +314,7 @@ fn extract(
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
                             out.feature_vertex.push(false);
-                            fan_centre.push(false);
+                            centres.push(false, false);
                         }
                         by_edge[e as usize] = *slot;
                     }
@@ -334,7 +335,12 @@ fn extract(
                                 (kind, solved) = better;
                             }
                         }
-                        feature = placement::place(solved, kind, &component).map(|f| (f, kind));
+                        feature = placement::place(solved, kind, &component).map(|mut placed| {
+                            if options.resample_creases {
+                                placed.check_surface(|p| sampler.distance(p), ON_SURFACE * grid.cell_size());
+                            }
+                            (placed, kind)
+                        });
                         out.rejected_features += feature.is_none() as usize;
                     }
                     plans.push(Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature });
@@ -365,7 +371,7 @@ fn extract(
                             out.mesh.positions.push(c);
                             normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
-                            fan_centre.push(false);
+                            centres.push(false, false);
                         }
                         let id = |v: u32| if v == EXTRA { extra_id } else { v };
                         out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
@@ -377,9 +383,9 @@ fn extract(
                     }
                     out.mesh.positions.push(f.position);
                     normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
-                    out.feature_vertex.push(f.on_feature);
-                    fan_centre.push(true);
-                    match (f.on_feature, kind) {
+                    out.feature_vertex.push(f.is_feature_vertex());
+                    centres.push(true, f.on_feature);
+                    match (f.is_feature_vertex(), kind) {
                         (false, _) => out.approximate_features += 1,
                         (true, FeatureKind::Corner) => out.corner_features += 1,
                         (true, _) => out.edge_features += 1,
@@ -393,18 +399,35 @@ fn extract(
         }
     }
     out.mesh.normals = normals_of_vertex;
-    (out, fan_centre, OutsideFans { index: cell_triangles, fans: outside_fans })
+    (out, centres, OutsideFans { index: cell_triangles, fans: outside_fans })
+}
+
+/// Per vertex: is it the centre of a feature fan (on the feature or approximately), and is it on
+/// its solved feature (a feature vertex, or one off the surface: see
+/// [`placement::Placed::check_surface`])? Flips join centres where one of them is on its feature.
+#[derive(Default)]
+struct FanCentres {
+    any: Vec<bool>,
+    on_feature: Vec<bool>,
+}
+
+impl FanCentres {
+    fn push(&mut self, centre: bool, on_feature: bool) {
+        self.any.push(centre);
+        self.on_feature.push(on_feature);
+    }
 }
 
 /// Moves the centres of fans outside their cell that cut a neighbour's triangles back inside
 /// (see [`untangle`]), keeping the feature flags and counts right.
 /// Returns how many moved; those are dropped from `outside`.
-fn pull_back(out: &mut EmcMesh, grid: &Grid, outside: &mut OutsideFans) -> usize {
+fn pull_back(out: &mut EmcMesh, centres: &mut FanCentres, grid: &Grid, outside: &mut OutsideFans) -> usize {
     let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &mut outside.fans);
     for fan in &moved {
         let v = fan.vertex as usize;
         out.pulled_back_features += 1;
-        if out.feature_vertex[v] && !fan.inside.on_feature {
+        centres.on_feature[v] &= fan.inside.on_feature;
+        if out.feature_vertex[v] && !fan.inside.is_feature_vertex() {
             let count = if fan.kind == FeatureKind::Corner {
                 &mut out.corner_features
             } else {
@@ -433,6 +456,12 @@ struct Plan<'a> {
     /// it would go inside (see [`untangle`]).
     feature: Option<(placement::Placed, FeatureKind)>,
 }
+
+/// How far (in cells) a feature point may lie from the surface, where the input can tell, and
+/// still count as on its feature: the precision resampled feature points are held to (the
+/// paper's tangent-plane points, `resample_creases: false`, are not checked: on curved creases
+/// they err by O(h²)).
+const ON_SURFACE: f32 = 0.01;
 
 /// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
 /// the inner vertex of the per-cell rules) before it has an id.

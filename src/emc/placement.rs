@@ -67,6 +67,17 @@ pub struct Placement {
     /// On the solved feature (candidates 1 and 2): a feature vertex. Otherwise (3 to 5) only an
     /// approximation that bends the patch toward it.
     pub on_feature: bool,
+    /// On the solved feature but, where the input can tell, off the surface (see
+    /// [`Placed::check_surface`]): not reported as a feature vertex.
+    pub off_surface: bool,
+}
+
+impl Placement {
+    /// Whether the centre is reported as a feature vertex: on its feature and not known to be
+    /// off the surface.
+    pub fn is_feature_vertex(&self) -> bool {
+        self.on_feature && !self.off_surface
+    }
 }
 
 /// The position of the feature point of `component` whose least-squares solution is `solved`,
@@ -92,6 +103,19 @@ pub struct Placed {
     pub inside: Option<Placement>,
 }
 
+impl Placed {
+    /// Marks a centre placed on its solved feature as off the surface where `distance` (an
+    /// estimate of the distance to the surface, where the input can tell) exceeds `tolerance`:
+    /// the feature's line can run past the end of its crease (where a third sheet the component
+    /// does not see cuts it off), and a point there is on two planes but not on the part. It
+    /// keeps its place (and takes part in flips as before); only its report changes.
+    pub fn check_surface(&mut self, distance: impl Fn(Vec3) -> Option<f32>, tolerance: f32) {
+        for at in std::iter::once(&mut self.at).chain(self.inside.as_mut()) {
+            at.off_surface = at.on_feature && distance(at.position).is_some_and(|d| d > tolerance);
+        }
+    }
+}
+
 fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: f32) -> Option<Placement> {
     let (pts, nrm) = (component.pts, component.nrm);
     let inner = component.grown(-INSET);
@@ -114,7 +138,7 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
     let clamped = solved.clamp(inner.0, inner.1);
     let exact = on_crease.filter(|&c| valid(c)).or_else(|| along(inner)).or_else(|| along(grown));
     if let Some(position) = exact {
-        return Some(Placement { position, on_feature: true });
+        return Some(Placement { position, on_feature: true, off_surface: false });
     }
     let off_feature = |c: Vec3| match line {
         Some(dir) => (c - solved).reject_from_normalized(dir).length(),
@@ -132,7 +156,7 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
                 .find(|&c| valid(c))
         })
         .or_else(|| nearest_valid_in_box(inner, off_feature, valid))
-        .map(|position| Placement { position, on_feature: false })
+        .map(|position| Placement { position, on_feature: false, off_surface: false })
 }
 
 /// The point of a lattice over `bounds` nearest to the feature (by `off_feature`) whose fan is
@@ -269,16 +293,21 @@ mod tests {
         assert!(off_crease < 0.15, "{} is {off_crease} cells from the crease", placed.position);
     }
 
-    #[test]
-    fn an_edge_point_outside_the_cell_is_slid_along_its_line_into_it() {
-        // Planes x = 0.5 (normal +x) and y = 0.5 (normal +y): the crease is the line x = y = 0.5.
+    /// A component on planes x = 0.5 (normal +x) and y = 0.5 (normal +y) between z = 0.2 and 0.8.
+    fn crease_x_y_half() -> ([Vec3; 4], [Vec3; 4]) {
         let pts = [
             Vec3::new(0.5, 0.0, 0.8),
             Vec3::new(0.5, 0.0, 0.2),
             Vec3::new(0.0, 0.5, 0.2),
             Vec3::new(0.0, 0.5, 0.8),
         ];
-        let nrm = [Vec3::X, Vec3::X, Vec3::Y, Vec3::Y];
+        (pts, [Vec3::X, Vec3::X, Vec3::Y, Vec3::Y])
+    }
+
+    #[test]
+    fn an_edge_point_outside_the_cell_is_slid_along_its_line_into_it() {
+        // Planes x = 0.5 (normal +x) and y = 0.5 (normal +y): the crease is the line x = y = 0.5.
+        let (pts, nrm) = crease_x_y_half();
         let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
         // The fan is valid for 0.2 < z < 0.8 only: the nearest valid point of the crease is taken.
         let placed = place(Vec3::new(0.5, 0.5, 1.4), FeatureKind::Edge, &component).unwrap().at;
@@ -286,6 +315,26 @@ mod tests {
         assert!(placed.on_feature);
         assert!((p.x - 0.5).abs() < 1e-6 && (p.y - 0.5).abs() < 1e-6, "{p} is off the crease");
         assert!(p.z > 0.75 && p.z < 0.8, "{p} is not the nearest valid point");
+    }
+
+    #[test]
+    fn a_point_on_its_line_but_off_the_surface_is_not_reported_as_a_feature_vertex() {
+        // The crease x = y = 0.5 of the test above, cut off at z = 0.7 by a third face the
+        // component does not see: its nearest valid point (z near 0.78) lies past the crease's end.
+        let (pts, nrm) = crease_x_y_half();
+        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        let solved = Vec3::new(0.5, 0.5, 1.4);
+        let mut placed = place(solved, FeatureKind::Edge, &component).unwrap();
+        let third_face = |p: Vec3| Some((p.z - 0.7).abs());
+        placed.check_surface(third_face, 0.01);
+        assert!(placed.at.on_feature && placed.at.off_surface && !placed.at.is_feature_vertex());
+        // Where the input cannot tell, or the point is on the surface, it stays a feature vertex.
+        let mut unknown = place(solved, FeatureKind::Edge, &component).unwrap();
+        unknown.check_surface(|_| None, 0.01);
+        assert!(unknown.at.is_feature_vertex());
+        let mut on_it = place(solved, FeatureKind::Edge, &component).unwrap();
+        on_it.check_surface(|_| Some(0.001), 0.01);
+        assert!(on_it.at.is_feature_vertex());
     }
 
     #[test]
