@@ -177,7 +177,10 @@ export interface MeshResult {
   positions: Float32Array;
   normals: Float32Array;
   indices: Uint32Array;
-  /** Sharp feature lines found by EMC as pairs of vertex indices (empty for MC): draw with gl.LINES. */
+  /**
+   * Sharp feature lines found by EMC as pairs of vertex indices (empty for MC): draw with gl.LINES.
+   * Gaps where a crease skims a cell are bridged through the approximate fan centre beside it.
+   */
   featureEdges: Uint32Array;
   /** Quad method: 4 vertex indices per quad (CCW = outward); `indices` triangulates them. Empty otherwise. */
   quads: Uint32Array;

@@ -21,8 +21,8 @@ pub const FLAT_TOLERANCE: f32 = 1e-3;
 const MIN_NORMAL_COSINE: f32 = 0.996;
 
 /// Collapses, into each fan centre, its nearest neighbour that is a flat crossing (see the module
-/// doc), then drops the removed vertices (`positions`, `normals` and `feature_vertex` are
-/// compacted, triangles renumbered). `h` is the cell size. Returns how many vertices were removed.
+/// doc), then drops the removed vertices (`positions`, `normals`, `fan_centre` and
+/// `feature_vertex` are compacted, triangles renumbered). `h` is the cell size. Returns how many vertices were removed.
 ///
 /// A collapse is refused when it would change the topology (the link condition: the centre and the
 /// crossing share exactly the two neighbours of their common edge), when it would join the centre
@@ -30,7 +30,7 @@ const MIN_NORMAL_COSINE: f32 = 0.996;
 /// or when a triangle would flip or degenerate.
 pub fn merge_flat_crossings(
     mesh: &mut Mesh,
-    fan_centre: &[bool],
+    fan_centre: &mut Vec<bool>,
     feature_vertex: &mut Vec<bool>,
     h: f32,
 ) -> usize {
@@ -62,7 +62,7 @@ pub fn merge_flat_crossings(
         merged += 1;
     }
     if merged > 0 {
-        compact(mesh, feature_vertex, &removed, &dead);
+        compact(mesh, [fan_centre, feature_vertex], &removed, &dead);
     }
     merged
 }
@@ -130,7 +130,7 @@ fn collapse(mesh: &mut Mesh, incident: &mut [Vec<u32>], dead: &mut [bool], a: u3
 }
 
 /// Drops removed vertices and dead triangles, renumbering what is left.
-fn compact(mesh: &mut Mesh, feature_vertex: &mut Vec<bool>, removed: &[bool], dead: &[bool]) {
+fn compact(mesh: &mut Mesh, flags: [&mut Vec<bool>; 2], removed: &[bool], dead: &[bool]) {
     let mut new_index = vec![u32::MAX; removed.len()];
     let mut next = 0u32;
     for (v, &gone) in removed.iter().enumerate() {
@@ -144,7 +144,9 @@ fn compact(mesh: &mut Mesh, feature_vertex: &mut Vec<bool>, removed: &[bool], de
     if !mesh.normals.is_empty() {
         mesh.normals = (0..removed.len()).filter(keep).map(|v| mesh.normals[v]).collect();
     }
-    *feature_vertex = (0..removed.len()).filter(keep).map(|v| feature_vertex[v]).collect();
+    for flag in flags {
+        *flag = (0..removed.len()).filter(keep).map(|v| flag[v]).collect();
+    }
     let triangles = std::mem::take(&mut mesh.triangles);
     mesh.triangles = triangles
         .into_iter()
@@ -197,7 +199,7 @@ mod tests {
         let mut centre = vec![false; 11];
         centre[8] = true;
         let mut feature = centre.clone();
-        assert_eq!(merge_flat_crossings(&mut mesh, &centre, &mut feature, 1.0), 1);
+        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 1);
         assert_eq!(mesh.vertex_count(), 10);
         assert_eq!(mesh.triangle_count(), 16);
         assert_eq!(feature.iter().filter(|&&f| f).count(), 1);
@@ -219,7 +221,7 @@ mod tests {
         let mut feature = centre.clone();
         // Ring vertices 1..7 are flat around their own neighbours, but each is joined to the apex
         // below, so none is flat; the raised crossing is off its plane by 0.01 > 1e-3.
-        assert_eq!(merge_flat_crossings(&mut mesh, &centre, &mut feature, 1.0), 0);
+        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 0);
         assert_eq!(mesh.triangle_count(), 18);
     }
 
@@ -231,6 +233,6 @@ mod tests {
         centre[8] = true;
         centre[3] = true;
         let mut feature = centre.clone();
-        assert_eq!(merge_flat_crossings(&mut mesh, &centre, &mut feature, 1.0), 0);
+        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 0);
     }
 }

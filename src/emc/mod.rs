@@ -15,6 +15,7 @@ pub mod directed;
 pub mod edges;
 pub mod feature;
 pub mod flip;
+pub mod lines;
 pub mod merge;
 pub mod mesh_source;
 pub mod placement;
@@ -115,7 +116,8 @@ pub struct EmcMesh {
     pub mesh: Mesh,
     /// Per vertex: was it placed on a detected edge or corner?
     pub feature_vertex: Vec<bool>,
-    /// Mesh edges joining two feature vertices: the reconstructed feature lines.
+    /// The reconstructed feature lines as mesh edges (see [`lines::feature_edges`]): between
+    /// feature vertices, bridged through an approximate centre where a crease has a gap.
     pub feature_edges: Vec<[u32; 2]>,
     pub edge_features: usize,
     pub corner_features: usize,
@@ -228,12 +230,12 @@ pub fn mesh_with_sampler(
     if options.merge_flat {
         out.flat_merges = merge::merge_flat_crossings(
             &mut out.mesh,
-            &centres.any,
+            &mut centres.any,
             &mut out.feature_vertex,
             grid.cell_size(),
         );
     }
-    out.feature_edges = feature_edges(&out.mesh, &out.feature_vertex);
+    out.feature_edges = lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex);
     timings.flip_ms = ms_since(t2);
     Ok((out, timings))
 }
@@ -508,18 +510,4 @@ impl Plan<'_> {
         let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
         (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
     }
-}
-
-/// Mesh edges whose two ends are feature vertices, each once.
-fn feature_edges(mesh: &Mesh, is_feature: &[bool]) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-        .filter(|[a, b]| is_feature[*a as usize] && is_feature[*b as usize])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
 }

@@ -232,16 +232,16 @@ fn link_is_path_or_cycle(link: &[(u32, u32)], nodes: &mut Vec<u32>) -> bool {
 }
 
 /// Disjoint sets over `0..n` with path halving (union by index keeps it short enough here).
-struct UnionFind {
+pub(crate) struct UnionFind {
     parent: Vec<u32>,
 }
 
 impl UnionFind {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         UnionFind { parent: (0..n as u32).collect() }
     }
 
-    fn find(&mut self, mut x: u32) -> u32 {
+    pub(crate) fn find(&mut self, mut x: u32) -> u32 {
         while self.parent[x as usize] != x {
             let grand = self.parent[self.parent[x as usize] as usize];
             self.parent[x as usize] = grand;
@@ -251,7 +251,7 @@ impl UnionFind {
     }
 
     /// Joins the sets of `a` and `b`; false when they were already one.
-    fn union(&mut self, a: u32, b: u32) -> bool {
+    pub(crate) fn union(&mut self, a: u32, b: u32) -> bool {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra == rb {
             return false;
