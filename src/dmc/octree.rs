@@ -86,6 +86,9 @@ pub struct Params {
     pub max_leaves: u64,
     /// Refinement rule 3 (see [`crate::dmc::refine`]) is applied.
     pub accuracy_rule: bool,
+    /// How far a leaf's free vertex may leave its leaf, as a fraction of its side
+    /// ([`crate::dmc::DmcOptions::vertex_reach`]).
+    pub vertex_reach: f32,
 }
 
 pub struct Octree {
@@ -315,6 +318,7 @@ mod tests {
             prune,
             max_leaves: 1 << 20,
             accuracy_rule: true,
+            vertex_reach: 0.0,
         }
     }
 
