@@ -221,7 +221,8 @@ fn planar_thin_room_at_depth_7_is_accurate_with_fewer_triangles_than_at_depth_6(
 /// intersection-free, Euler 2, one part) with half the triangles or fewer: 976 at depth 5 with
 /// `tolerance` 0.008 (max distance 0.025, 1.6 % of the room: under the paper's 1 000 triangles but
 /// not within its 1 %), 6 068 at depth 6 with the default tolerance (0.0126, 0.8 %; 11 548 with the
-/// rule). Still no setting found gives both < 1 000 triangles and < 1 % (see the README).
+/// rule). Both < 1 000 triangles and < 1 % need vertices that may leave their leaves (see
+/// `planar_thin_room_within_1_percent_under_1000_triangles_with_vertex_reach`).
 #[test]
 fn planar_thin_room_without_the_accuracy_rule() {
     let field = expr::compile(PLANAR_ROOM).unwrap();
