@@ -81,7 +81,7 @@ fn free_vertex(tree: &Octree, field: &dyn Field, n: u32, on_surface_allowed: boo
     let iso = tree.params.iso;
     let (lo, hi) = shrunk(tree, n);
     let linear = node.straddles && node.rank == 1;
-    let reach = (hi - lo) * tree.params.vertex_reach;
+    let reach = (hi - lo) * if node.confined { 0.0 } else { tree.params.vertex_reach };
     let mut vertex = free_minimiser(tree, n, lo - reach, hi + reach);
     let mut value = field.value(vertex) - iso;
     if on_surface_allowed && linear {

@@ -80,9 +80,12 @@ pub struct DmcOptions {
     /// the junction of two thin walls, the minimiser lies on the junction in the neighbouring leaf;
     /// clamped to the leaf's face, the vertex leaves the room's inner edge up to a leaf's width
     /// from every crossing, and the triangles cut the edge. With 0.25 and `tolerance` 0.01 the
-    /// planar room is within 1 % in < 1 000 triangles at depth 5 (README, "Thin walls"); on other scenes it moves the
-    /// error both ways, so it is off by default. The pruning argument of `refine` (rule 1) assumes
-    /// vertices inside their leaves and is not proved for a reach above 0.
+    /// planar room is within 1 % in < 1 000 triangles at depth 5 (README, "Thin walls"). Where
+    /// the dual grid still folds or crosses at the maximum depth, the vertices go back into their
+    /// leaves before any centring (`refine`). Off by default: measured on five scenes it never
+    /// raised the maximum distance, but it changes every mesh and coarsens some normals (README).
+    /// The pruning argument of `refine` (rule 1) assumes vertices inside their leaves and is not
+    /// proved for a reach above 0.
     pub vertex_reach: f32,
 }
 
@@ -291,6 +294,11 @@ pub fn mesh_field(
 fn apply(tree: &mut Octree, field: &dyn Field, plan: &refine::Plan) -> Result<bool, Error> {
     for &n in &plan.split {
         tree.refine(field, n)?;
+    }
+    for &n in &plan.confine {
+        let node = &mut tree.nodes[n as usize];
+        node.confined = true;
+        node.has_vertex = false;
     }
     for &n in &plan.centre {
         let node = &mut tree.nodes[n as usize];

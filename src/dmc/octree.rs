@@ -73,6 +73,9 @@ pub struct Node {
     pub vertex: Vec3,
     pub value: f32,
     pub has_vertex: bool,
+    /// The vertex is kept in the leaf whatever [`Params::vertex_reach`] allows: out of it, it
+    /// folded the contour or made it cross itself (refinement rules 4 and 5).
+    pub confined: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,6 +126,7 @@ impl Node {
             vertex: Vec3::ZERO,
             value: 0.0,
             has_vertex: false,
+            confined: false,
         }
     }
 }
