@@ -82,8 +82,9 @@ pub struct DmcOptions {
     /// from every crossing, and the triangles cut the edge. With 0.25 and `tolerance` 0.01 the
     /// planar room is within 1 % in < 1 000 triangles at depth 5 (README, "Thin walls"). Where
     /// the dual grid still folds or crosses at the maximum depth, the vertices go back into their
-    /// leaves before any centring (`refine`). Off by default: measured on five scenes it never
-    /// raised the maximum distance, but it changes every mesh and coarsens some normals (README).
+    /// leaves before any centring (`refine`). Off by default: measured on five scenes it lowered
+    /// or kept the maximum distance except on the cube minus sphere at depth 5, but it changes
+    /// every mesh and coarsens some normals (README, "Thin walls").
     /// The pruning argument of `refine` (rule 1) assumes vertices inside their leaves and is not
     /// proved for a reach above 0.
     pub vertex_reach: f32,

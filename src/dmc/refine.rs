@@ -91,7 +91,12 @@ impl Plan {
     }
 
     /// Split the largest splittable sampled leaves of a dual cell; where none can be split,
-    /// centre its sampled leaves instead (when `centre_if_stuck`). Before centring, vertices that
+    /// centre one of its sampled leaves instead (when `centre_if_stuck`): the one whose vertex is
+    /// farthest from its centre (relative to its side), the likeliest to fold the cell; the next
+    /// round centres another if the cell still folds or crosses. Centring all of them at once
+    /// chamfered curved creases: on the cube minus sphere at depth 5 every triangle over 0.0067
+    /// came from a dual cell with a centred leaf (max distance 0.0141 against 0.0037 one at a
+    /// time; rotated box 0.0187 against 0.0086, fandisk 0.0208 against 0.0084). Before centring, vertices that
     /// left their leaves (`vertex_reach`) go back into them (`confine`), and the cell is centred only
     /// if it still folds or crosses: a vertex out of its leaf reaches into the dual cells of its
     /// neighbours, and centring the cell's own leaves does not move it (the rounded thin room at
@@ -109,9 +114,16 @@ impl Plan {
                 self.confine.extend(cell.iter().map(|r| r.node).filter(|&n| out_of_leaf(tree, n)))
             }
             None if centre_if_stuck => {
-                self.centre.extend(cell.iter().map(|r| r.node).filter(|&n| {
-                    tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred
-                }))
+                let off_centre = |n: u32| {
+                    let (lo, hi) = tree.cell(n);
+                    ((tree.nodes[n as usize].vertex - (lo + hi) * 0.5) / (hi - lo)).length()
+                };
+                let farthest = cell
+                    .iter()
+                    .map(|r| r.node)
+                    .filter(|&n| tree.nodes[n as usize].kind == Kind::Leaf && !tree.nodes[n as usize].centred)
+                    .max_by(|&a, &b| off_centre(a).total_cmp(&off_centre(b)));
+                self.centre.extend(farthest)
             }
             None => {}
         }
