@@ -111,6 +111,8 @@ pub struct Request {
     /// DMC: refinement rule 3, the triangles' distance to the surface (see
     /// [`DmcOptions::accuracy_rule`]).
     pub accuracy_rule: bool,
+    /// DMC: how far a vertex may leave its leaf (see [`DmcOptions::vertex_reach`]).
+    pub vertex_reach: f32,
 }
 
 impl Default for Request {
@@ -139,6 +141,7 @@ impl Default for Request {
             samples_per_cell: DmcOptions::default().samples_per_cell,
             paper_only: false,
             accuracy_rule: true,
+            vertex_reach: DmcOptions::default().vertex_reach,
         }
     }
 }
@@ -157,6 +160,7 @@ impl Request {
             max_cells: self.max_cells,
             paper_only: self.paper_only,
             accuracy_rule: self.accuracy_rule,
+            vertex_reach: self.vertex_reach,
             ..DmcOptions::default()
         }
     }

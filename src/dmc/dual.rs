@@ -213,6 +213,7 @@ mod tests {
             prune: false,
             max_leaves: 1 << 20,
             accuracy_rule: true,
+            vertex_reach: 0.0,
         };
         Octree::build(&field, Vec3::splat(-1.0), 2.0, params).unwrap()
     }

@@ -7,6 +7,11 @@
 //! - The vertex is kept in the leaf shrunk by [`SHRINK`] of its side, so two leaves never share a
 //!   vertex position (a feature exactly on a cell face would otherwise give both cells the same
 //!   point, and the mesh two coincident vertices). Boundary vertices keep their pinned coordinate.
+//!   [`super::DmcOptions::vertex_reach`] lets the free vertex follow the minimiser out of the leaf
+//!   by a fraction of its side (off by default): a leaf next to a thin wall's junction, holding
+//!   part of one wall only, has its minimiser on the junction in the neighbouring leaf, and clamped
+//!   to its own face the vertex leaves a gap between the crossings and the wall's inner edge that
+//!   no split closes at the maximum depth (see the README, "Thin walls").
 //! - The stored value is `f(vertex) - iso`, evaluated, not the QEF's estimate, so the sign of a
 //!   vertex is the sign of the field at a point of its leaf (the pruning argument relies on it).
 //! - **Signs around features.** Dual Marching Cubes sees the surface only through the signs of the
@@ -76,7 +81,8 @@ fn free_vertex(tree: &Octree, field: &dyn Field, n: u32, on_surface_allowed: boo
     let iso = tree.params.iso;
     let (lo, hi) = shrunk(tree, n);
     let linear = node.straddles && node.rank == 1;
-    let mut vertex = free_minimiser(tree, n, lo, hi);
+    let reach = (hi - lo) * if node.confined { 0.0 } else { tree.params.vertex_reach };
+    let mut vertex = free_minimiser(tree, n, lo - reach, hi + reach);
     let mut value = field.value(vertex) - iso;
     if on_surface_allowed && linear {
         let restricted = tree.qefs[node.qef as usize].minimise_in_box(lo, hi, Some(0.0));

@@ -73,6 +73,9 @@ pub struct Node {
     pub vertex: Vec3,
     pub value: f32,
     pub has_vertex: bool,
+    /// The vertex is kept in the leaf whatever [`Params::vertex_reach`] allows: out of it, it
+    /// folded the contour or made it cross itself (refinement rules 4 and 5).
+    pub confined: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,6 +89,9 @@ pub struct Params {
     pub max_leaves: u64,
     /// Refinement rule 3 (see [`crate::dmc::refine`]) is applied.
     pub accuracy_rule: bool,
+    /// How far a leaf's free vertex may leave its leaf, as a fraction of its side
+    /// ([`crate::dmc::DmcOptions::vertex_reach`]).
+    pub vertex_reach: f32,
 }
 
 pub struct Octree {
@@ -120,6 +126,7 @@ impl Node {
             vertex: Vec3::ZERO,
             value: 0.0,
             has_vertex: false,
+            confined: false,
         }
     }
 }
@@ -315,6 +322,7 @@ mod tests {
             prune,
             max_leaves: 1 << 20,
             accuracy_rule: true,
+            vertex_reach: 0.0,
         }
     }
 

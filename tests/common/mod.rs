@@ -56,3 +56,8 @@ pub fn assert_watertight(mesh: &Mesh, what: &str) -> analysis::Topology {
     }
     topo
 }
+
+/// The thin room written with planar primitives, as the paper builds it: walls 0.016 thick (1 % of
+/// the room), a door through the wall at y = -0.8 whose sill lies 0.042 above the floor.
+pub const PLANAR_ROOM: &str = "b = max(abs(x) - 0.8, abs(y) - 0.8, abs(z) - 0.5); room = abs(b) - 0.008; \
+     door = translate(max(abs(x) - 0.2, abs(y) - 0.1, abs(z) - 0.325), 0, -0.8, -0.125); max(room, -door)";
