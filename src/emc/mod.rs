@@ -19,6 +19,7 @@ pub mod lines;
 pub mod merge;
 pub mod mesh_source;
 pub mod placement;
+mod plan;
 pub mod point_source;
 pub mod resample;
 pub mod untangle;
@@ -26,19 +27,19 @@ pub mod untangle;
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
-use crate::mc::{joined_faces, ms_since, polygon_center, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
-use crate::mcq::polygon::triangulate_cell_polygon;
+use crate::mc::{joined_faces, ms_since, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
 use crate::mcq::PolygonRules;
 use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
 use crate::tables::{
     polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
-    CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS,
+    CellTriangles, CORNERS, EDGES, EDGE_AXIS,
 };
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, FeatureKind};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use placement::{Component, Placed};
+use plan::{Plan, EXTRA};
 use untangle::{CellTriangleIndex, OutsideFan, OutsideFans};
 use web_time::Instant;
 
@@ -443,71 +444,8 @@ fn pull_back(out: &mut EmcMesh, centres: &mut FanCentres, grid: &Grid, outside: 
     moved.len()
 }
 
-/// What one component of a cell will become: its polygon and, where sharp, its feature point.
-struct Plan<'a> {
-    by_edge: [u32; 13],
-    /// The polygon's vertex ids and positions, in order.
-    ids: Vec<u32>,
-    pts: Vec<Vec3>,
-    nrm: Vec<Vec3>,
-    /// The cell edges its vertices sit on, in the same order.
-    cell_edges: &'a [u8],
-    /// Its triangles in the cell's MC triangulation (triangle indices).
-    group: std::ops::Range<usize>,
-    /// Where the fan centre goes, what the feature is, and, for a centre outside the cell, where
-    /// it would go inside (see [`untangle`]).
-    feature: Option<(placement::Placed, FeatureKind)>,
-}
-
 /// How far (in cells) a feature point may lie from the surface, where the input can tell, and
 /// still count as on its feature: the precision resampled feature points are held to (the
 /// paper's tangent-plane points, `resample_creases: false`, are not checked: on curved creases
 /// they err by O(h²)).
 const ON_SURFACE: f32 = 0.01;
-
-/// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
-/// the inner vertex of the per-cell rules) before it has an id.
-const EXTRA: u32 = u32::MAX;
-
-impl Plan<'_> {
-    /// The triangles this component would emit, as positions (fan, or as [`Plan::plain`]).
-    fn triangles(
-        &self,
-        positions: &[Vec3],
-        table: &CellTriangles,
-        rules: Option<&PolygonRules>,
-    ) -> Vec<[DVec3; 3]> {
-        let n = self.pts.len();
-        match self.feature {
-            Some((f, _)) => (0..n)
-                .map(|q| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3()))
-                .collect(),
-            None => {
-                let (tris, extra) = self.plain(positions, table, rules);
-                let at = |v: u32| match (v, extra) {
-                    (EXTRA, Some(c)) => c.as_dvec3(),
-                    _ => positions[v as usize].as_dvec3(),
-                };
-                tris.iter().map(|t| t.map(at)).collect()
-            }
-        }
-    }
-
-    /// The triangles of the component without a feature point, by vertex id ([`EXTRA`] for an
-    /// added vertex, whose position comes along): MC's table, or with `rules` the per-cell polygon
-    /// rules of [`crate::mcq`].
-    fn plain(
-        &self,
-        positions: &[Vec3],
-        table: &CellTriangles,
-        rules: Option<&PolygonRules>,
-    ) -> (Vec<[u32; 3]>, Option<Vec3>) {
-        if let Some(rules) = rules {
-            return triangulate_cell_polygon(&self.ids, &self.pts, self.cell_edges, rules, EXTRA);
-        }
-        let group = &table.edges[3 * self.group.start..3 * self.group.end];
-        let extra = group.contains(&CENTER).then(|| polygon_center(positions, group, &self.by_edge));
-        let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
-        (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
-    }
-}

@@ -1,0 +1,74 @@
+//! One component of a cell on its way out: its polygon, and where sharp its feature point, with
+//! the triangles either would emit (a fan, or MC's table / the per-cell rules): what the cell's
+//! passes in [`super`] look at before anything is written to the mesh.
+
+use super::feature::FeatureKind;
+use super::placement;
+use crate::mc::polygon_center;
+use crate::mcq::polygon::triangulate_cell_polygon;
+use crate::mcq::PolygonRules;
+use crate::tables::{CellTriangles, CENTER};
+use glam::{DVec3, Vec3};
+
+/// What one component of a cell will become: its polygon and, where sharp, its feature point.
+pub(super) struct Plan<'a> {
+    pub by_edge: [u32; 13],
+    /// The polygon's vertex ids and positions, in order.
+    pub ids: Vec<u32>,
+    pub pts: Vec<Vec3>,
+    pub nrm: Vec<Vec3>,
+    /// The cell edges its vertices sit on, in the same order.
+    pub cell_edges: &'a [u8],
+    /// Its triangles in the cell's MC triangulation (triangle indices).
+    pub group: std::ops::Range<usize>,
+    /// Where the fan centre goes, what the feature is, and, for a centre outside the cell, where
+    /// it would go inside (see [`super::untangle`]).
+    pub feature: Option<(placement::Placed, FeatureKind)>,
+}
+
+/// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
+/// the inner vertex of the per-cell rules) before it has an id.
+pub(super) const EXTRA: u32 = u32::MAX;
+
+impl Plan<'_> {
+    /// The triangles this component would emit, as positions (fan, or as [`Plan::plain`]).
+    pub fn triangles(
+        &self,
+        positions: &[Vec3],
+        table: &CellTriangles,
+        rules: Option<&PolygonRules>,
+    ) -> Vec<[DVec3; 3]> {
+        let n = self.pts.len();
+        match self.feature {
+            Some((f, _)) => (0..n)
+                .map(|q| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3()))
+                .collect(),
+            None => {
+                let (tris, extra) = self.plain(positions, table, rules);
+                let at = |v: u32| match (v, extra) {
+                    (EXTRA, Some(c)) => c.as_dvec3(),
+                    _ => positions[v as usize].as_dvec3(),
+                };
+                tris.iter().map(|t| t.map(at)).collect()
+            }
+        }
+    }
+
+    /// The triangles of the component without a feature point, by vertex id ([`EXTRA`] for an
+    /// added vertex, whose position comes along): MC's table, or with `rules` the per-cell polygon
+    /// rules of [`crate::mcq`].
+    pub fn plain(
+        &self,
+        positions: &[Vec3],
+        table: &CellTriangles,
+        rules: Option<&PolygonRules>,
+    ) -> (Vec<[u32; 3]>, Option<Vec3>) {
+        if let Some(rules) = rules {
+            return triangulate_cell_polygon(&self.ids, &self.pts, self.cell_edges, rules, EXTRA);
+        }
+        let group = &table.edges[3 * self.group.start..3 * self.group.end];
+        let extra = group.contains(&CENTER).then(|| polygon_center(positions, group, &self.by_edge));
+        let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
+        (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
+    }
+}
