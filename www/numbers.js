@@ -8,7 +8,7 @@ const fmt = (v, digits = 3) => v === null || v === undefined ? '—'
 /** Rows of [label, stats key], in the order shown; keys a method does not report are skipped. */
 const ROWS = [
   ['triangles', 'triangles'], ['vertices', 'vertices'], ['quads', 'quads'],
-  ['closed manifold', 'closed_manifold'], ['Euler characteristic', 'euler'],
+  ['closed manifold', 'closed_manifold'], ['Euler characteristic', 'euler'], ['components', 'components'],
   ['max distance', 'dist_max'], ['RMS distance', 'dist_rms'],
   ['normal deviation p95 (°)', 'normal_dev_deg_p95'],
   ['smallest angle (°)', 'min_angle_deg'], ['largest angle (°)', 'max_angle_deg'],

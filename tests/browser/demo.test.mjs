@@ -82,12 +82,33 @@ test('gallery scenes load into the editor and re-mesh both sides with their own 
     assert.equal(await stat(page, side, 'Euler characteristic'), '0');
     assert.equal(await stat(page, side, 'closed manifold'), 'yes');
   }
-  // The rocket is not checked here: DMC splits it in two at the demo's depth (a known failure,
-  // listed in tests/dmc.rs), which this test would only repeat.
-  await page.click('#gallery button[data-scene="fandisk"]');
+  for (const [scene, source] of [['fandisk', /cylinder/], ['rocket', /fin/]]) {
+    await page.click(`#gallery button[data-scene="${scene}"]`);
+    await settled(page);
+    assert.match(await page.inputValue('#source'), source);
+    for (const side of [LEFT, RIGHT]) {
+      assert.equal(await stat(page, side, 'Euler characteristic'), '2', `${scene} ${side}`);
+      assert.equal(await stat(page, side, 'components'), '1', `${scene} ${side}`);
+    }
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('DMC meshes the thin-walled room under 1 000 triangles within 1 % with a vertex reach', async () => {
+  const { page, errors } = await openDemo();
+  await page.fill('#source', 'b = max(abs(x) - 0.8, abs(y) - 0.8, abs(z) - 0.5);\nroom = abs(b) - 0.008;\n'
+    + 'door = translate(max(abs(x) - 0.2, abs(y) - 0.1, abs(z) - 0.325), 0, -0.8, -0.125);\nmax(room, -door)');
+  await page.fill('#tol', '0.01');
+  await page.fill('#depth', '5');
+  await page.fill('#reach', '0.25');
+  await page.click('#run');
   await settled(page);
-  assert.match(await page.inputValue('#source'), /cylinder/);
-  for (const side of [LEFT, RIGHT]) assert.equal(await stat(page, side, 'Euler characteristic'), '2');
+  assert.equal(await stat(page, RIGHT, 'closed manifold'), 'yes');
+  assert.equal(await stat(page, RIGHT, 'Euler characteristic'), '2');
+  assert.ok(await count(page, RIGHT, 'triangles') < 1000);
+  // The room is 1.6 across: 1 % is 0.016.
+  assert.ok(await count(page, RIGHT, 'max distance') < 0.016);
   assert.deepEqual(errors, []);
   await page.close();
 });
