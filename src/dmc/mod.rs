@@ -82,11 +82,16 @@ pub struct DmcOptions {
     /// from every crossing, and the triangles cut the edge. With 0.25 and `tolerance` 0.01 the
     /// planar room is within 1 % in < 1 000 triangles at depth 5 (README, "Thin walls"). Where
     /// the dual grid still folds or crosses at the maximum depth, the vertices go back into their
-    /// leaves before any centring (`refine`). Off by default: measured on five scenes it lowered
-    /// or kept the maximum distance except on the cube minus sphere at depth 5, but it changes
-    /// every mesh and coarsens some normals (README, "Thin walls").
-    /// The pruning argument of `refine` (rule 1) assumes vertices inside their leaves and is not
-    /// proved for a reach above 0.
+    /// leaves before any centring (`refine`). Off by default: measured on five scenes at depths 5
+    /// and 6 it lowered or kept the maximum distance, but it changes every mesh and coarsens some
+    /// normals (README, "Thin walls").
+    ///
+    /// A vertex leaves its leaf only where it fits the leaf's tangent planes strictly better out
+    /// there and keeps the side of the iso-level of the leaf's own minimiser
+    /// (`features::reached_vertex`): on the rounded thin room, reached vertices beside the rounded
+    /// outer edges crossed into the walls and folded the dual cells (4040 triangles instead of
+    /// 1048). So a vertex's sign is still the field's at a point of its leaf, the premise of the
+    /// pruning argument of `refine` (rule 1).
     pub vertex_reach: f32,
 }
 
