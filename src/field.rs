@@ -141,6 +141,11 @@ impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> Field for BatchFn<F> {
     }
 }
 
+/// Gradient of `field` at `p`: its own where it knows one, else central differences with step `h`.
+pub fn gradient_or_differences(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
+    field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h))
+}
+
 /// Central-difference gradient with step `h`: the fallback for fields that know no gradient.
 pub fn finite_difference_gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
     let dx = Vec3::new(h, 0.0, 0.0);

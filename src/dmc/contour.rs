@@ -118,8 +118,7 @@ pub fn triangle_error(mesh: &Mesh, t: usize, field: &dyn Field, iso: f32, h: f32
     [(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]
         .into_iter()
         .map(|p: Vec3| {
-            let g =
-                field.gradient(p).unwrap_or_else(|| crate::field::finite_difference_gradient(field, p, h));
+            let g = crate::field::gradient_or_differences(field, p, h);
             let len = g.length();
             let d = (field.value(p) - iso).abs();
             if len > 1e-12 {

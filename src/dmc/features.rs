@@ -40,7 +40,7 @@
 
 use super::dual::CellRef;
 use super::octree::{Kind, Octree, NONE};
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{gradient_or_differences, Field};
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -96,7 +96,7 @@ fn free_vertex(tree: &Octree, field: &dyn Field, n: u32, on_surface_allowed: boo
     if linear {
         // Move the vertex a quarter cell into the solid along the gradient.
         let h = (hi - lo).max_element();
-        let g = field.gradient(vertex).unwrap_or_else(|| finite_difference_gradient(field, vertex, h * 1e-3));
+        let g = gradient_or_differences(field, vertex, h * 1e-3);
         let slope = g.length();
         if slope > 1e-12 {
             let target = -0.25 * h * slope;
@@ -316,7 +316,7 @@ fn snap_noise(field: &dyn Field, p: Vec3, value: f32, root_size: f32, inside: bo
     if value.abs() > tiny * 1e3 {
         return value;
     }
-    let g = field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, tiny * 10.0));
+    let g = gradient_or_differences(field, p, tiny * 10.0);
     if value.abs() > tiny * g.length() {
         value
     } else if inside {

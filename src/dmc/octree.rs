@@ -24,7 +24,7 @@
 
 use super::qef::Qef;
 use crate::error::Error;
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{gradient_or_differences, Field};
 use glam::Vec3;
 
 pub const NONE: u32 = u32::MAX;
@@ -283,7 +283,7 @@ impl Octree {
         let mut nearest = f32::INFINITY;
         let h = (hi - lo).max_element() * 1e-3;
         for (&p, &v) in self.points.iter().zip(&self.values) {
-            let g = field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h));
+            let g = gradient_or_differences(field, p, h);
             if !v.is_finite() || !g.is_finite() {
                 // The value, or else the first bad gradient component, names the problem.
                 let bad = std::iter::once(v).chain(g.to_array()).find(|c| !c.is_finite());

@@ -40,7 +40,7 @@ use super::dual::CellRef;
 use super::features::uncentred_value;
 use super::memo::Memo;
 use super::octree::{Kind, Octree};
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{gradient_or_differences, Field};
 use crate::tables::{triangle_table, EDGES};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -179,13 +179,8 @@ pub fn plan(
     let tolerance = tree.params.tolerance;
     let h = tree.cell_size(tree.params.max_depth) * 1e-2;
     let mesh = &contour.mesh;
-    let gradients: Vec<Vec3> = mesh
-        .positions
-        .iter()
-        .map(|&p| {
-            memo.gradient(p, || field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)))
-        })
-        .collect();
+    let gradients: Vec<Vec3> =
+        mesh.positions.iter().map(|&p| memo.gradient(p, || gradient_or_differences(field, p, h))).collect();
     let mut inaccurate = Vec::new();
     let mut folded = Vec::new();
     for t in 0..mesh.triangle_count() {

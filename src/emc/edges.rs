@@ -4,7 +4,7 @@
 //! to float precision); from samples alone it is the linear interpolation plain MC uses, the baseline
 //! the paper improves on.
 
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{gradient_or_differences, Field};
 use crate::mc::MIN_EDGE_FRACTION;
 use glam::Vec3;
 
@@ -57,9 +57,7 @@ impl EdgeSampler for FieldRoots<'_> {
         if !self.directed {
             return None;
         }
-        let h = self.h * 1e-3;
-        let slope =
-            self.field.gradient(p).unwrap_or_else(|| finite_difference_gradient(self.field, p, h)).length();
+        let slope = gradient_or_differences(self.field, p, self.h * 1e-3).length();
         let d = (self.field.value(p) - self.iso).abs() / slope;
         (slope > 0.0 && d.is_finite()).then_some(d)
     }
@@ -132,7 +130,7 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
 
 /// Unit normal of the field at `p`: its gradient, or central differences when it has none.
 pub fn field_normal(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
-    field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h)).normalize_or_zero()
+    gradient_or_differences(field, p, h).normalize_or_zero()
 }
 
 #[cfg(test)]

@@ -2,13 +2,8 @@
 //! relaxation (tangential smoothing, then re-projection) that evens out the octree's staircase.
 
 use super::mesh::QuadMesh;
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{gradient_or_differences as gradient, Field};
 use glam::Vec3;
-
-/// Gradient of the field, exact where it knows one, else central differences with step `h`.
-fn gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
-    field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h))
-}
 
 /// Moves `p` onto f = 0 by Newton steps along the gradient. Each step is capped at `max_step`
 /// (a cell) so a vertex near a saddle or a crease cannot be thrown across the model; the
