@@ -15,19 +15,22 @@ use crate::mesh::Mesh;
 /// that is not a feature vertex) whose feature-vertex neighbours lie on two or more pieces of
 /// those lines, one edge to the nearest neighbour on each piece. Each edge once, `[low, high]`.
 pub fn feature_edges(mesh: &Mesh, fan_centre: &[bool], is_feature: &[bool]) -> Vec<[u32; 2]> {
-    let all_edges = || mesh.triangles.iter().flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]]);
-    let mut edges: Vec<[u32; 2]> = all_edges()
-        .filter(|[a, b]| is_feature[*a as usize] && is_feature[*b as usize])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .collect();
+    let approximate = |v: u32| fan_centre[v as usize] && !is_feature[v as usize];
+    // One pass over the mesh edges: those between feature vertices, and each approximate centre's
+    // edges to feature vertices as `[centre, feature vertex]`.
+    let (mut edges, mut bridges): (Vec<[u32; 2]>, Vec<[u32; 2]>) = (Vec::new(), Vec::new());
+    for [a, b] in mesh.triangles.iter().flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]]) {
+        let (fa, fb) = (is_feature[a as usize], is_feature[b as usize]);
+        if fa && fb {
+            edges.push([a.min(b), a.max(b)]);
+        } else if fb && approximate(a) {
+            bridges.push([a, b]);
+        } else if fa && approximate(b) {
+            bridges.push([b, a]);
+        }
+    }
     edges.sort_unstable();
     edges.dedup();
-    let approximate = |v: u32| fan_centre[v as usize] && !is_feature[v as usize];
-    // Each approximate centre's feature-vertex neighbours.
-    let mut bridges: Vec<[u32; 2]> = all_edges()
-        .flat_map(|[a, b]| [[a, b], [b, a]])
-        .filter(|[a, b]| approximate(*a) && is_feature[*b as usize])
-        .collect();
     if bridges.is_empty() {
         return edges;
     }
