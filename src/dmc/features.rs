@@ -138,22 +138,22 @@ fn reached_vertex(
 ) -> (Vec3, f32, bool) {
     let iso = tree.params.iso;
     let inside = tree.nodes[n as usize].inside;
-    let vertex = free_minimiser(tree, n, lo - reach, hi + reach);
+    let qef = &tree.qefs[tree.nodes[n as usize].qef as usize];
+    let reached = qef.minimise_in_box(lo - reach, hi + reach, None);
+    let vertex = reached.position.as_vec3().clamp(lo - reach, hi + reach);
     let value = field.value(vertex) - iso;
     if vertex.cmpge(lo).all() && vertex.cmple(hi).all() {
         return (vertex, value, inside);
     }
-    let qef = &tree.qefs[tree.nodes[n as usize].qef as usize];
-    let inner = free_minimiser(tree, n, lo, hi);
+    let own = qef.minimise_in_box(lo, hi, None);
+    let inner = own.position.as_vec3().clamp(lo, hi);
     let inner_value = field.value(inner) - iso;
     let inner_negative = snap_noise(field, inner, inner_value, tree.size, inside) < 0.0;
     let snapped = |inside: bool| snap_noise(field, vertex, value, tree.size, inside);
     // Within rounding noise of the iso-level, the two rules give the two sides.
     let on_surface = snapped(true) != snapped(false);
     let same_side = on_surface || (snapped(inside) < 0.0) == inner_negative;
-    let better =
-        qef.minimise_in_box(lo - reach, hi + reach, None).rms < qef.minimise_in_box(lo, hi, None).rms;
-    match better && same_side {
+    match reached.rms < own.rms && same_side {
         true => (vertex, value, if on_surface { inner_negative } else { inside }),
         false => (inner, inner_value, inside),
     }
