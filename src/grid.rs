@@ -4,6 +4,11 @@
 use crate::error::Error;
 use glam::Vec3;
 
+/// Is `p` in the closed box `[lo, hi]` (cells, leaves, grown cells)?
+pub fn in_box(p: Vec3, (lo, hi): (Vec3, Vec3)) -> bool {
+    p.cmpge(lo).all() && p.cmple(hi).all()
+}
+
 /// Default cap on the number of cells, chosen so that one f32 per sample plus MC's edge caches stay
 /// well inside a browser tab's memory (about 300 MB of samples at the cap).
 pub const DEFAULT_MAX_CELLS: u64 = 72_000_000;

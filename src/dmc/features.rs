@@ -41,6 +41,7 @@
 use super::dual::CellRef;
 use super::octree::{Kind, Octree, NONE};
 use crate::field::{gradient_or_differences, Field};
+use crate::grid::in_box;
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -142,7 +143,7 @@ fn reached_vertex(
     let reached = qef.minimise_in_box(lo - reach, hi + reach, None);
     let vertex = reached.position.as_vec3().clamp(lo - reach, hi + reach);
     let value = field.value(vertex) - iso;
-    if vertex.cmpge(lo).all() && vertex.cmple(hi).all() {
+    if in_box(vertex, (lo, hi)) {
         return (vertex, value, inside);
     }
     let own = qef.minimise_in_box(lo, hi, None);

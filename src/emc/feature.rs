@@ -1,6 +1,7 @@
 //! Feature detection and feature sampling of EMC (§4.2, §4.3): is the surface inside a cell sharp,
 //! and where is the edge or corner it hides?
 
+use crate::grid::in_box;
 use glam::{DVec3, Vec3};
 use nalgebra::{Matrix3, Vector3};
 
@@ -96,8 +97,7 @@ pub fn sharp_point(
         return (kind, solved);
     }
     let corner = feature_point(points, normals, FeatureKind::Corner);
-    let in_reach = corner.cmpge(near.0).all() && corner.cmple(near.1).all();
-    if in_reach && plane_miss(points, normals, corner) < 0.5 * miss {
+    if in_box(corner, near) && plane_miss(points, normals, corner) < 0.5 * miss {
         (FeatureKind::Corner, corner)
     } else {
         (kind, solved)

@@ -25,6 +25,7 @@
 //! and 3 (a fan triangle lying in a cell face would overlap the neighbour's).
 
 use super::feature::{crease_direction, FeatureKind};
+use crate::grid::in_box;
 use glam::Vec3;
 
 /// How far (in cells) points placed in the cell stay off its faces.
@@ -53,11 +54,6 @@ impl Component<'_> {
         let margin = (self.cell_max - self.cell_min) * growth;
         (self.cell_min - margin, self.cell_max + margin)
     }
-}
-
-/// Is `p` in the closed box `(lo, hi)`?
-pub fn contains((lo, hi): (Vec3, Vec3), p: Vec3) -> bool {
-    p.cmpge(lo).all() && p.cmple(hi).all()
 }
 
 /// Where a fan centre went.
@@ -89,7 +85,7 @@ impl Placement {
 pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
     let at = place_within(solved, kind, component, GROWTH)?;
     let p = at.position;
-    if contains((component.cell_min, component.cell_max), p) {
+    if in_box(p, (component.cell_min, component.cell_max)) {
         return Some(Placed { at, inside: None });
     }
     let inside = place_within(solved, kind, component, -INSET)?;
@@ -128,7 +124,7 @@ fn place_within(solved: Vec3, kind: FeatureKind, component: &Component, growth: 
     let in_box = |(lo, hi): (Vec3, Vec3)| match line {
         Some(dir) => line_in_box(solved, dir, lo, hi)
             .map(|(s0, s1)| (solved + dir * 0.0f32.clamp(s0, s1)).clamp(lo, hi)),
-        None => contains((lo, hi), solved).then_some(solved),
+        None => in_box(solved, (lo, hi)).then_some(solved),
     };
     let on_crease = in_box(inner);
     let along = |bounds: (Vec3, Vec3)| match line {

@@ -11,7 +11,8 @@
 
 use super::edges::EdgeSampler;
 use super::feature::{feature_point, widest_pair_indices, FeatureKind};
-use super::placement::{contains, Component, GROWTH};
+use super::placement::{Component, GROWTH};
+use crate::grid::in_box;
 use glam::Vec3;
 
 /// How far (in cells) into each sheet, from the solved point, the sheet is sampled again.
@@ -132,7 +133,7 @@ pub fn resample_component(
         if third.dot(nrm[a]) < theta_sharp && third.dot(nrm[b]) < theta_sharp {
             let guess = feature_point(pts, nrm, FeatureKind::Corner);
             let corner = resample_feature(guess, FeatureKind::Corner, pts, nrm, sampler, cell)
-                .filter(|&c| contains(near, c));
+                .filter(|&c| in_box(c, near));
             if let Some(corner) = corner {
                 return Some((FeatureKind::Corner, corner));
             }

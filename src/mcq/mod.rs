@@ -14,7 +14,7 @@ pub use polygon::PolygonRules;
 
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledField};
-use crate::grid::{Grid, DEFAULT_MAX_CELLS};
+use crate::grid::{in_box, Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since, set_normals};
 use crate::mesh::{analysis, Mesh};
 use crate::tables::polygon_table;
@@ -266,7 +266,7 @@ fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 
     let lo = grid.position(cell[0], cell[1], cell[2]);
     let hi = lo + grid.spacing;
     let p = newton(field, iso, start, [true; 3]);
-    let inside = p.cmpge(lo).all() && p.cmple(hi).all() && p.is_finite();
+    let inside = in_box(p, (lo, hi)) && p.is_finite();
     if inside {
         p
     } else {
