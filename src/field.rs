@@ -30,6 +30,14 @@ pub trait Field {
             *o = self.value(*p);
         }
     }
+
+    /// [`Field::gradient`] at many points at once, the same per point. Evaluators that vectorise
+    /// override this: a DMC octree takes a gradient at each of `samples_per_cell³` points per cell.
+    fn gradients(&self, points: &[Vec3], out: &mut [Option<Vec3>]) {
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            *o = self.gradient(*p);
+        }
+    }
 }
 
 /// Any `Fn(Vec3) -> f32` closure is a field (without a gradient).
@@ -144,6 +152,27 @@ impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> Field for BatchFn<F> {
 /// Gradient of `field` at `p`: its own where it knows one, else central differences with step `h`.
 pub fn gradient_or_differences(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
     field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, h))
+}
+
+/// [`gradient_or_differences`] at many points, through [`Field::gradients`]; `out` is resized to
+/// `points`, and `scratch` is working memory a caller can keep across calls.
+pub fn gradients_or_differences(
+    field: &dyn Field,
+    points: &[Vec3],
+    h: f32,
+    scratch: &mut Vec<Option<Vec3>>,
+    out: &mut Vec<Vec3>,
+) {
+    scratch.clear();
+    scratch.resize(points.len(), None);
+    field.gradients(points, scratch);
+    out.clear();
+    out.extend(
+        points
+            .iter()
+            .zip(scratch.iter())
+            .map(|(&p, g)| g.unwrap_or_else(|| finite_difference_gradient(field, p, h))),
+    );
 }
 
 /// Central-difference gradient with step `h`: the fallback for fields that know no gradient.

@@ -24,7 +24,7 @@
 
 use super::qef::Qef;
 use crate::error::Error;
-use crate::field::{gradient_or_differences, Field};
+use crate::field::{gradients_or_differences, Field};
 use glam::Vec3;
 
 pub const NONE: u32 = u32::MAX;
@@ -102,8 +102,11 @@ pub struct Octree {
     pub size: f32,
     pub params: Params,
     leaves: u64,
+    /// Working memory of [`Octree::sample`], kept across cells.
     points: Vec<Vec3>,
     values: Vec<f32>,
+    exact: Vec<Option<Vec3>>,
+    gradients: Vec<Vec3>,
 }
 
 impl Node {
@@ -143,6 +146,8 @@ impl Octree {
             leaves: 1,
             points: Vec::new(),
             values: Vec::new(),
+            exact: Vec::new(),
+            gradients: Vec::new(),
         };
         tree.decide(field, 0, params.prune)?;
         Ok(tree)
@@ -282,8 +287,8 @@ impl Octree {
         let (mut below, mut above) = (false, false);
         let mut nearest = f32::INFINITY;
         let h = (hi - lo).max_element() * 1e-3;
-        for (&p, &v) in self.points.iter().zip(&self.values) {
-            let g = gradient_or_differences(field, p, h);
+        gradients_or_differences(field, &self.points, h, &mut self.exact, &mut self.gradients);
+        for ((&p, &v), &g) in self.points.iter().zip(&self.values).zip(&self.gradients) {
             if !v.is_finite() || !g.is_finite() {
                 // The value, or else the first bad gradient component, names the problem.
                 let bad = std::iter::once(v).chain(g.to_array()).find(|c| !c.is_finite());

@@ -1,6 +1,6 @@
-//! Running a [`Tape`]: one generic interpreter for single points (plain values, values with
-//! gradients, intervals), and a column interpreter that runs each instruction over 64 points at
-//! once so the per-instruction dispatch is paid once per chunk and simple loops vectorise.
+//! Running a [`Tape`] at single points: one generic interpreter for plain values, values with
+//! gradients and intervals (the column interpreters for many points are in
+//! [`super::columns`]).
 //!
 //! Everything is `f32`, like the [`crate::field::Field`] trait: meshing never needs more, and the
 //! gradient tests pass against central differences at f32 precision.
@@ -169,83 +169,6 @@ pub fn eval_gradient(tape: &Tape, p: Vec3) -> (f32, Vec3) {
     (r.v, r.d)
 }
 
-/// Points per column: enough to amortise dispatch, few enough that slots × lanes stays in cache.
-pub const LANES: usize = 64;
-
-type Column = [f32; LANES];
-
-/// Values at many points; only the first `min(points.len(), out.len())` are written.
-pub fn eval_columns(tape: &Tape, points: &[Vec3], out: &mut [f32]) {
-    let n = points.len().min(out.len());
-    if n == 0 {
-        return;
-    }
-    let mut cols: Vec<Column> = vec![[0.0; LANES]; tape.slot_count];
-    for (col, &c) in cols.iter_mut().zip(&tape.consts) {
-        col.fill(c);
-    }
-    for start in (0..n).step_by(LANES) {
-        let chunk = &points[start..n.min(start + LANES)];
-        for (axis, input) in tape.inputs.iter().enumerate() {
-            if let Some(s) = input {
-                let col = &mut cols[*s as usize];
-                for (c, p) in col.iter_mut().zip(chunk) {
-                    *c = p[axis];
-                }
-            }
-        }
-        for instr in &tape.instrs {
-            run_column(instr, &mut cols);
-        }
-        out[start..start + chunk.len()].copy_from_slice(&cols[tape.output as usize][..chunk.len()]);
-    }
-}
-
-/// The output column mutably and the operand columns shared, split out of one slice; the tape
-/// guarantees the output is not an operand.
-fn split(cols: &mut [Column], out: u32, a: u32, b: u32) -> (&mut Column, &Column, &Column) {
-    let out = out as usize;
-    let (before, rest) = cols.split_at_mut(out);
-    let (o, after) = rest.split_first_mut().expect("output slot is in range");
-    let pick = |i: u32| -> &Column {
-        let i = i as usize;
-        if i < out {
-            &before[i]
-        } else {
-            &after[i - out - 1]
-        }
-    };
-    (o, pick(a), pick(b))
-}
-
-fn run_column(instr: &Instr, cols: &mut [Column]) {
-    match *instr {
-        Instr::Unary { op, out, a } => {
-            let (o, a, _) = split(cols, out, a, a);
-            match op {
-                UnaryOp::Neg => o.iter_mut().zip(a).for_each(|(o, a)| *o = -a),
-                UnaryOp::Abs => o.iter_mut().zip(a).for_each(|(o, a)| *o = a.abs()),
-                UnaryOp::Sqrt => o.iter_mut().zip(a).for_each(|(o, a)| *o = a.sqrt()),
-                UnaryOp::Powi(2) => o.iter_mut().zip(a).for_each(|(o, a)| *o = a * a),
-                op => o.iter_mut().zip(a).for_each(|(o, &a)| *o = ops::unary(op, a)),
-            }
-        }
-        Instr::Binary { op, out, a, b } => {
-            let (o, a, b) = split(cols, out, a, b);
-            let lanes = o.iter_mut().zip(a.iter().zip(b));
-            match op {
-                BinaryOp::Add => lanes.for_each(|(o, (a, b))| *o = a + b),
-                BinaryOp::Sub => lanes.for_each(|(o, (a, b))| *o = a - b),
-                BinaryOp::Mul => lanes.for_each(|(o, (a, b))| *o = a * b),
-                BinaryOp::Div => lanes.for_each(|(o, (a, b))| *o = a / b),
-                BinaryOp::Min => lanes.for_each(|(o, (a, b))| *o = a.min(*b)),
-                BinaryOp::Max => lanes.for_each(|(o, (a, b))| *o = a.max(*b)),
-                op => lanes.for_each(|(o, (&a, &b))| *o = ops::binary(op, a, b)),
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::compile;
@@ -291,23 +214,6 @@ mod tests {
                 let (a, b) = (program.eval(p), program.eval_grad(p).0);
                 assert!(a == b || (a.is_nan() && b.is_nan()), "{case} at {p}: {a} vs {b}");
             }
-        }
-    }
-
-    #[test]
-    fn eval_many_equals_eval_pointwise() {
-        let mut rng = Rng::new(3);
-        for case in CASES {
-            let program = compile(case).unwrap();
-            // Not a multiple of the column width, so the last chunk is partial.
-            let points: Vec<Vec3> = (0..150).map(|_| rng.vec3(-1.5, 1.5)).collect();
-            let mut out = vec![f32::NAN; points.len() + 3];
-            program.eval_many(&points, &mut out);
-            for (p, &v) in points.iter().zip(&out) {
-                let e = program.eval(*p);
-                assert!(e == v || (e.is_nan() && v.is_nan()), "{case} at {p}: column {v} vs point {e}");
-            }
-            assert!(out[points.len()..].iter().all(|v| v.is_nan()), "wrote past the points");
         }
     }
 

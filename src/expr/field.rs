@@ -17,6 +17,14 @@ impl Field for Program {
         self.eval_many(points, out);
     }
 
+    fn gradients(&self, points: &[Vec3], out: &mut [Option<Vec3>]) {
+        let mut exact = vec![Vec3::ZERO; points.len().min(out.len())];
+        self.eval_grad_many(points, &mut exact);
+        for (o, g) in out.iter_mut().zip(exact) {
+            *o = Some(g);
+        }
+    }
+
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
         Some(self.eval_interval(lo, hi))
     }

@@ -56,6 +56,7 @@
 
 pub mod ast;
 mod builtins;
+mod columns;
 mod compile;
 pub mod csg;
 mod csg_json;

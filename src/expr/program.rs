@@ -1,8 +1,9 @@
 //! [`Program`]: a compiled field, and the one public face of every evaluation mode.
 
+use super::columns::{eval_columns, eval_gradient_columns};
 use super::compile::compile_script;
 use super::csg::CsgNode;
-use super::eval::{eval_columns, eval_gradient, eval_point};
+use super::eval::{eval_gradient, eval_point};
 use super::graph::{Graph, Node, NodeId};
 use super::interval::{self, Choice};
 use super::ops::BinaryOp;
@@ -81,6 +82,12 @@ impl Program {
     /// `min(points.len(), out.len())` values, like [`crate::field::Field::values`].
     pub fn eval_many(&self, points: &[Vec3], out: &mut [f32]) {
         eval_columns(&self.tape, points, out);
+    }
+
+    /// Gradients at many points, 64 at a time, bit for bit [`Program::eval_grad`]'s. Writes
+    /// `min(points.len(), out.len())` gradients.
+    pub fn eval_grad_many(&self, points: &[Vec3], out: &mut [Vec3]) {
+        eval_gradient_columns(&self.tape, points, out);
     }
 
     /// A shorter program equal to this one wherever `choices` hold (typically inside the box
