@@ -1,5 +1,5 @@
 //! The compiled evaluator against the reference tree walk on the same points, in the same run:
-//! `expr/<program>/{tree_walk,value,value_gradient,batch64,interval}`, throughput in points (boxes
+//! `expr/<program>/{tree_walk,value,value_gradient,batch64,gradient_batch64,interval}`, throughput in points (boxes
 //! for `interval`) per second. The programs are the README's rocket scene and a formula-heavy
 //! sample with shared bindings, where the tape's common-subexpression sharing matters.
 //!
@@ -39,6 +39,13 @@ fn evaluator(c: &mut Criterion) {
             b.iter(|| {
                 program.eval_many(&pts, &mut out);
                 out[0]
+            })
+        });
+        let mut gradients = vec![Vec3::ZERO; pts.len()];
+        group.bench_function(BenchmarkId::from_parameter("gradient_batch64"), |b| {
+            b.iter(|| {
+                program.eval_grad_many(&pts, &mut gradients);
+                gradients[0].x
             })
         });
         let half = Vec3::splat(1.0 / 32.0);

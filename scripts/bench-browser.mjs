@@ -17,11 +17,11 @@ try {
     return Object.entries(programs).map(([name, text]) => ({ name, ...m.measureEvaluator(text, 4096, minMs) }));
   }, [BLOB, minMs]);
   console.log(`Chromium ${browser.version()}, ns per point (per box for interval); x = speed-up over the tree walk`);
-  console.log('| program | instructions | tree walk | value | value+gradient | batch of 64 | interval |');
-  console.log('|---|---|---|---|---|---|---|');
+  console.log('| program | instructions | tree walk | value | value+gradient | batch of 64 | gradients, batch of 64 | interval |');
+  console.log('|---|---|---|---|---|---|---|---|');
   for (const r of rows) {
     const cell = (v) => `${v.toFixed(1)} (${(r.treeWalk / v).toFixed(1)}x)`;
-    console.log(`| ${r.name} | ${r.instructions} | ${r.treeWalk.toFixed(1)} | ${cell(r.value)} | ${cell(r.valueGradient)} | ${cell(r.batch)} | ${cell(r.interval)} |`);
+    console.log(`| ${r.name} | ${r.instructions} | ${r.treeWalk.toFixed(1)} | ${cell(r.value)} | ${cell(r.valueGradient)} | ${cell(r.batch)} | ${cell(r.gradientBatch)} | ${cell(r.interval)} |`);
   }
 } finally {
   await browser.close();

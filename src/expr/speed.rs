@@ -19,6 +19,8 @@ pub struct EvaluatorSpeed {
     pub value_gradient: f64,
     /// [`Program::eval_many`]: 64-point columns, what grids and octrees use.
     pub batch: f64,
+    /// [`Program::eval_grad_many`]: gradients in 64-point columns, what octrees use.
+    pub gradient_batch: f64,
     /// [`Program::eval_interval`] over boxes of a 32nd of the domain.
     pub interval: f64,
     /// Tape length after folding and sharing.
@@ -55,13 +57,24 @@ pub fn measure(
         program.eval_many(&points, &mut out);
         out.iter().sum()
     });
+    let (_, grad_x_sum) = per_point(&mut || points.iter().map(|&p| program.eval_grad(p).1.x).sum());
+    let mut gradients = vec![Vec3::ZERO; points.len()];
+    let (gradient_batch, gradient_batch_sum) = per_point(&mut || {
+        program.eval_grad_many(&points, &mut gradients);
+        gradients.iter().map(|g| g.x).sum()
+    });
     let half = Vec3::splat(1.0 / 32.0);
     let (interval, _) =
         per_point(&mut || points.iter().map(|&p| program.eval_interval(p - half, p + half).0).sum());
     let close = |a: f32, b: f32| (a - b).abs() <= 1e-3 * a.abs().max(1.0) || (a.is_nan() && b.is_nan());
-    if !(close(tree_sum, value_sum) && close(value_sum, grad_sum) && close(value_sum, batch_sum)) {
+    let agree = close(tree_sum, value_sum)
+        && close(value_sum, grad_sum)
+        && close(value_sum, batch_sum)
+        && close(grad_x_sum, gradient_batch_sum);
+    if !agree {
         return Err(Error::InvalidOption(format!(
-            "evaluation modes disagree: tree {tree_sum}, value {value_sum}, gradient {grad_sum}, batch {batch_sum}"
+            "evaluation modes disagree: tree {tree_sum}, value {value_sum}, gradient {grad_sum}, batch {batch_sum}, \
+             gradient x {grad_x_sum} against batched {gradient_batch_sum}"
         )));
     }
     Ok(EvaluatorSpeed {
@@ -69,6 +82,7 @@ pub fn measure(
         value,
         value_gradient,
         batch,
+        gradient_batch,
         interval,
         instructions: Program::instruction_count(&program),
     })

@@ -111,7 +111,8 @@ export type BatchFieldFunction = (points: Float32Array) => Float32Array | number
 
 /** Nanoseconds per point (per box for `interval`) of each evaluation mode: see measureEvaluator. */
 export interface EvaluatorSpeed {
-  treeWalk: number; value: number; valueGradient: number; batch: number; interval: number;
+  treeWalk: number; value: number; valueGradient: number; batch: number; gradientBatch: number;
+  interval: number;
   instructions: number;
 }
 
