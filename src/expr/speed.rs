@@ -115,7 +115,7 @@ mod tests {
             t.get()
         };
         let s = measure("union(sphere(0.5), box(.2, .3, .4))", 100, 0.5, &now).unwrap();
-        for v in [s.tree_walk, s.value, s.value_gradient, s.batch, s.interval] {
+        for v in [s.tree_walk, s.value, s.value_gradient, s.batch, s.gradient_batch, s.interval] {
             assert!(v > 0.0 && v.is_finite(), "{s:?}");
         }
         assert!(s.instructions > 3);
