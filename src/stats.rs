@@ -53,6 +53,10 @@ pub struct Stats {
     pub normal_dev_deg_p50: Option<f64>,
     pub normal_dev_deg_p95: Option<f64>,
     pub normal_dev_deg_max: Option<f64>,
+    /// Faces at a sharp edge, and their normal deviation p95 (see
+    /// [`analysis::SurfaceError::crease_faces`]): where "crinkly" edges show.
+    pub crease_faces: Option<usize>,
+    pub crease_normal_dev_deg_p95: Option<f64>,
     /// Wall-clock time of the meshing itself (all phases, analysis excluded).
     pub ms_total: f64,
     /// Time per phase of the method, in the order they ran (a JSON object, insertion ordered).
@@ -143,6 +147,8 @@ pub fn compute(
         normal_dev_deg_p50: error.as_ref().map(|e| e.normal_dev_deg_p50),
         normal_dev_deg_p95: error.as_ref().map(|e| e.normal_dev_deg_p95),
         normal_dev_deg_max: error.as_ref().map(|e| e.normal_dev_deg_max),
+        crease_faces: error.as_ref().map(|e| e.crease_faces),
+        crease_normal_dev_deg_p95: error.as_ref().map(|e| e.crease_normal_dev_deg_p95),
         ms_total,
         phases_ms,
         ms_analysis: crate::mc::ms_since(t0),

@@ -11,6 +11,7 @@ const ROWS = [
   ['closed manifold', 'closed_manifold'], ['Euler characteristic', 'euler'], ['components', 'components'],
   ['max distance', 'dist_max'], ['RMS distance', 'dist_rms'],
   ['normal deviation p95 (°)', 'normal_dev_deg_p95'],
+  ['  at sharp edges (°)', 'crease_normal_dev_deg_p95'],
   ['smallest angle (°)', 'min_angle_deg'], ['largest angle (°)', 'max_angle_deg'],
   ['feature edges', 'feature_edges'],
   ['octree leaves', 'octree_leaves'], ['dual cells', 'dual_cells'],

@@ -126,6 +126,9 @@ export interface MeshStats {
   aspect_ratio_mean: number; aspect_ratio_max: number; area: number; volume: number;
   dist_max: number | null; dist_rms: number | null;
   normal_dev_deg_p50: number | null; normal_dev_deg_p95: number | null; normal_dev_deg_max: number | null;
+  /** Faces at a sharp edge (true normals at their corners over 30° apart), and their normal
+   * deviation p95: where "crinkly" edges show. */
+  crease_faces: number | null; crease_normal_dev_deg_p95: number | null;
   /** Milliseconds of meshing (analysis excluded). */
   ms_total: number;
   /** Milliseconds per phase, in the order the phases ran. */

@@ -22,6 +22,15 @@ pub struct SurfaceError {
     pub normal_dev_deg_p50: f64,
     pub normal_dev_deg_p95: f64,
     pub normal_dev_deg_max: f64,
+    /// Faces at a crease: the true normals at their corners' projections onto the surface differ
+    /// by more than [`CREASE_DEG`]. On a mesh that keeps its sharp edges these faces border the
+    /// crease and lie flat against one side of it; where the crease is cut or zigzags ("crinkly"
+    /// edges) they tilt across it. The whole-mesh percentiles above hide them among flat faces.
+    /// Meaningful only where the mesh resolves the curvature: on a coarse sphere (an octahedron)
+    /// every face counts.
+    pub crease_faces: usize,
+    /// The 95th percentile of the normal deviation over the crease faces alone, by area.
+    pub crease_normal_dev_deg_p95: f64,
     /// Distance samples taken: every referenced vertex plus four points per triangle.
     pub samples: usize,
     /// Samples whose projection did not settle (vanishing gradient, or still moving after the last
@@ -32,6 +41,11 @@ pub struct SurfaceError {
 /// Newton iterations per projection: signed distance fields need one, smooth fields two or three
 /// from a mesh that is already close; more than this means the estimate is not trustworthy.
 const MAX_STEPS: usize = 8;
+
+/// Corner normals further apart than this mark a face as sitting at a crease: far above the turn
+/// of a curved surface across one face of a mesh that resolves it (a few degrees), far below the
+/// dihedral angles of the creases we mesh.
+pub const CREASE_DEG: f64 = 30.0;
 
 /// Measures `mesh` against the zero set of `field`.
 ///
@@ -78,10 +92,18 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         result.dist_max = result.dist_max.max(projection.distance);
         sum_sq += projection.distance * projection.distance;
     };
-    for (p, _) in mesh.positions.iter().zip(&referenced).filter(|(_, &r)| r) {
-        record(&projector.project(p.as_dvec3()));
+    // The true normal at each referenced vertex's projection, for finding the crease faces.
+    let mut corner_normals = vec![DVec3::ZERO; mesh.positions.len()];
+    for ((p, _), normal) in
+        mesh.positions.iter().zip(&referenced).zip(&mut corner_normals).filter(|((_, &r), _)| r)
+    {
+        let projection = projector.project(p.as_dvec3());
+        record(&projection);
+        *normal = projector.gradient(projection.point).normalize_or_zero();
     }
+    let crease_cos = CREASE_DEG.to_radians().cos();
     let mut deviations = Vec::with_capacity(faces.len());
+    let mut crease_deviations = Vec::new();
     for &[a, b, c] in &faces {
         let corners = [a, b, c].map(|v| mesh.positions[v as usize].as_dvec3());
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
@@ -93,8 +115,16 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
         let gradient = projector.gradient(on_surface.point).normalize_or_zero();
         if normal != DVec3::ZERO && gradient != DVec3::ZERO {
-            let angle = normal.cross(gradient).length().atan2(normal.dot(gradient));
-            deviations.push(angle.to_degrees());
+            let angle = normal.cross(gradient).length().atan2(normal.dot(gradient)).to_degrees();
+            deviations.push(angle);
+            let n = [a, b, c].map(|v| corner_normals[v as usize]);
+            let at_crease = [(0, 1), (1, 2), (2, 0)]
+                .iter()
+                .any(|&(i, j)| n[i] != DVec3::ZERO && n[j] != DVec3::ZERO && n[i].dot(n[j]) < crease_cos);
+            if at_crease {
+                let area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length() * 0.5;
+                crease_deviations.push((angle, area));
+            }
         }
     }
     result.dist_rms = (sum_sq / result.samples as f64).sqrt();
@@ -102,7 +132,25 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
     result.normal_dev_deg_p50 = nearest_rank(&deviations, 0.50);
     result.normal_dev_deg_p95 = nearest_rank(&deviations, 0.95);
     result.normal_dev_deg_max = deviations.last().copied().unwrap_or(0.0);
+    crease_deviations.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    result.crease_faces = crease_deviations.len();
+    result.crease_normal_dev_deg_p95 = area_weighted_rank(&crease_deviations, 0.95);
     result
+}
+
+/// The smallest value with at least `fraction` of the total weight at or below it, over
+/// `(value, weight)` pairs sorted by value; 0 for none. Weighted by area, slivers along a crease
+/// (heights of 1e-5 of the bounds, normals set by rounding) count as little as they show.
+fn area_weighted_rank(sorted: &[(f64, f64)], fraction: f64) -> f64 {
+    let total: f64 = sorted.iter().map(|&(_, w)| w).sum();
+    let mut below = 0.0;
+    for &(value, weight) in sorted {
+        below += weight;
+        if below >= fraction * total {
+            return value;
+        }
+    }
+    sorted.last().map_or(0.0, |&(value, _)| value)
 }
 
 /// The smallest value with at least `fraction` of `sorted` at or below it; 0 for no values.
@@ -185,6 +233,29 @@ mod tests {
         assert!(e.dist_rms > 0.0 && e.dist_rms < e.dist_max);
         // Face normals point through the centroids, exactly along the sphere's gradient there.
         assert!(e.normal_dev_deg_max < 1e-3, "{e:?}");
+    }
+
+    /// MC cuts a box's edges with chamfer faces (normals ~45° off), EMC puts vertices on them; the
+    /// crease statistic sees exactly that, the whole-mesh p95 of MC much less.
+    #[test]
+    fn crease_faces_show_mcs_chamfers_and_emcs_sharp_edges() {
+        let field = crate::expr::compile("box(0.5, 0.4, 0.3)").unwrap();
+        let grid = crate::grid::Grid::with_resolution(Vec3::splat(-0.7), Vec3::splat(0.7), 20).unwrap();
+        let (mc, _) = crate::mc::mesh_field(&field, &grid, &crate::mc::McOptions::default()).unwrap();
+        let (emc, _) = crate::emc::mesh_field(&field, &grid, &crate::emc::EmcOptions::default()).unwrap();
+        let (mc, emc) = (surface_error(&mc, &field), surface_error(&emc.mesh, &field));
+        assert!(mc.crease_faces > 50 && emc.crease_faces > 50, "{mc:?} {emc:?}");
+        assert!(mc.crease_normal_dev_deg_p95 > 30.0, "{mc:?}");
+        assert!(mc.normal_dev_deg_p95 < mc.crease_normal_dev_deg_p95, "{mc:?}");
+        assert!(emc.crease_normal_dev_deg_p95 < 1.0, "{emc:?}");
+    }
+
+    #[test]
+    fn weighted_ranks_count_area_not_faces() {
+        let slivers_and_one_face = [(1.0, 10.0), (80.0, 1e-6), (90.0, 1e-6)];
+        assert_eq!(area_weighted_rank(&slivers_and_one_face, 0.95), 1.0);
+        assert_eq!(area_weighted_rank(&[(1.0, 1.0), (50.0, 1.0)], 0.95), 50.0);
+        assert_eq!(area_weighted_rank(&[], 0.95), 0.0);
     }
 
     #[test]
