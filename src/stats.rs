@@ -40,6 +40,9 @@ pub struct Stats {
     pub degenerate_triangles: usize,
     /// `None` when the check was skipped.
     pub self_intersections: Option<usize>,
+    /// Pairs of triangles lying on each other across an edge (the surface overlapping itself
+    /// without crossing; see [`analysis::folded_pairs`]).
+    pub folded_pairs: usize,
     pub min_angle_deg: f64,
     pub max_angle_deg: f64,
     /// Triangle angles in 5° bins, 0–5°, 5–10°, …, 175–180°.
@@ -135,6 +138,7 @@ pub fn compute(
         misoriented_edges: topo.misoriented_edges,
         degenerate_triangles: topo.degenerate_triangles,
         self_intersections: intersections,
+        folded_pairs: analysis::folded_pairs(mesh).len(),
         min_angle_deg: angles.min_deg,
         max_angle_deg: angles.max_deg,
         angle_histogram_5deg: angles.histogram_5deg.to_vec(),

@@ -37,6 +37,7 @@ fn dmc_mesh(scene: &Scene, pairing: &Pairing) -> (Mesh, SurfaceError) {
         DmcOptions { max_depth: pairing.max_depth, tolerance: pairing.tolerance, ..DmcOptions::default() };
     let (mesh, _) = dmc::mesh_field(scene.field.as_ref(), scene.min, scene.max, &options).unwrap();
     assert_watertight(&mesh, &format!("{} dmc", pairing.scene));
+    assert!(analysis::folded_pairs(&mesh).is_empty(), "{} dmc: folded triangles", pairing.scene);
     let error = analysis::surface_error(&mesh, scene.field.as_ref());
     (mesh, error)
 }

@@ -15,8 +15,11 @@ use wasm_bindgen_test::wasm_bindgen_test as test;
 #[cfg(target_arch = "wasm32")]
 wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
+/// DMC's mesh and stats, asserting that no two triangles fold onto each other across an edge.
 fn dmc_mesh(field: &dyn Field, min: Vec3, max: Vec3, options: &DmcOptions) -> (Mesh, dmc::DmcStats) {
-    dmc::mesh_field(field, min, max, options).unwrap()
+    let (mesh, stats) = dmc::mesh_field(field, min, max, options).unwrap();
+    assert_eq!(analysis::folded_pairs(&mesh), Vec::<[u32; 2]>::new(), "folded triangles ({options:?})");
+    (mesh, stats)
 }
 
 /// The target, with `vertex_reach` 0.25 (vertices may follow their QEF minimiser a quarter

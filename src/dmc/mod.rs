@@ -13,7 +13,8 @@
 //! - [`memo`]: root finding, gradients and triangle errors remembered across refinement rounds.
 //! - [`refine`]: the fixpoints run once the dual grid is known (un-pruning, representing every
 //!   straddling leaf, splitting leaves under inaccurate triangles).
-//! - [`slivers`]: collapsing the tiny triangles around vertices that lie on the surface.
+//! - [`slivers`]: collapsing the tiny triangles around vertices that lie on the surface (and
+//!   [`crate::mesh::pleats`] triangulating again flat discs where a triangle is turned over).
 //!
 //! **Options.** `tolerance` is a fraction of the longest side of the bounds; it bounds both the QEF
 //! residual of a leaf (root-mean-square 4-D distance of its sampled tangent planes from its vertex)
@@ -33,6 +34,7 @@ use crate::error::Error;
 use crate::field::Field;
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::ms_since;
+use crate::mesh::pleats::unpleat;
 use crate::mesh::Mesh;
 use dual::CellRef;
 use features::DualVertices;
@@ -314,7 +316,7 @@ fn apply(tree: &mut Octree, field: &dyn Field, plan: &refine::Plan) -> Result<bo
     Ok(!plan.is_empty())
 }
 
-/// Sliver collapse and the final self-intersection check. A merge that makes two sheets cross (thin
+/// Sliver collapse, pleats triangulated again, and the final self-intersection check. A merge that makes two sheets cross (thin
 /// walls bring sheets within the tolerance of each other) is undone by collapsing again without the
 /// dual vertices involved; intersections that remain are the dual grid's (rule 5).
 fn finish(
@@ -328,7 +330,14 @@ fn finish(
     let mut contour = contour;
     slivers::collapse_zero_edges(&mut contour);
     slivers::flip_caps(&mut contour);
-    let intersections = |c: &contour::Contour| crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
+    unpleat(&mut contour.mesh, Some(&mut contour.cell_of_triangle));
+    // Folds (triangles lying on each other across an edge) are treated as crossings: both are
+    // the surface overlapping itself.
+    let intersections = |c: &contour::Contour| {
+        let mut pairs = crate::mesh::analysis::self_intersecting_pairs(&c.mesh);
+        pairs.extend(crate::mesh::analysis::folded_pairs(&c.mesh));
+        pairs
+    };
     if !options.sliver_elimination {
         let pairs = intersections(&contour);
         return (contour, pairs);
@@ -340,6 +349,7 @@ fn finish(
             slivers::collapse(&mut collapsed, vertices, field, options.iso, tolerance, &skip);
         slivers::collapse_zero_edges(&mut collapsed);
         slivers::flip_caps(&mut collapsed);
+        unpleat(&mut collapsed.mesh, Some(&mut collapsed.cell_of_triangle));
         let pairs = intersections(&collapsed);
         let culprits: Vec<u32> = pairs
             .iter()

@@ -4,6 +4,7 @@ use glam::Vec3;
 
 pub mod analysis;
 pub mod export;
+pub mod pleats;
 
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from outside, so face normals
 /// (by the right-hand rule) point out of the solid.

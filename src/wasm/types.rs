@@ -122,6 +122,8 @@ export interface MeshStats {
   closed_manifold: boolean; euler: number; genus: number | null; components: number;
   boundary_edges: number; non_manifold_edges: number; non_manifold_vertices: number;
   misoriented_edges: number; degenerate_triangles: number; self_intersections: number | null;
+  /** Pairs of triangles lying on each other across an edge (a fold, not a crossing). */
+  folded_pairs: number;
   min_angle_deg: number; max_angle_deg: number; angle_histogram_5deg: number[];
   aspect_ratio_mean: number; aspect_ratio_max: number; area: number; volume: number;
   dist_max: number | null; dist_rms: number | null;

@@ -7,12 +7,18 @@
 //!   a spike through a neighbour), see [`overlap_beyond_shared_vertex`];
 //! - two or three: never (neighbours across an edge, or duplicates, are the topology's business).
 //!
+//! Neighbours across an edge that lie on top of each other are counted apart, by [`folded_pairs`]:
+//! a fold is the surface overlapping itself without crossing. DMC's pleats (a triangle turned over
+//! among flat neighbours) are folds; so are Marching Cubes' zero-thickness sheets where samples
+//! equal the iso-level and two cells' triangles lie in their shared face, which is why folds are not
+//! self-intersections here.
+//!
 //! Vertices are identified by index, so an unwelded mesh (one copy of a vertex per triangle) reports
 //! every pair of neighbours as touching: weld it first. Collapsed triangles (repeated index) are
 //! skipped; zero-area triangles with distinct indices are tested as the segments they are.
 
 use super::bvh::{Aabb, Bvh};
-use super::tri_tri::{overlap_beyond_shared_vertex, triangles_intersect};
+use super::tri_tri::{folded_across_edge, overlap_beyond_shared_vertex, triangles_intersect};
 use crate::mesh::Mesh;
 use glam::DVec3;
 
@@ -66,6 +72,33 @@ pub fn triangle_pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
     }
 }
 
+/// Pairs `[i, j]` (`i < j`, sorted) of triangles sharing an edge that fold onto each other (see
+/// [`folded_across_edge`]). Collapsed triangles are skipped.
+pub fn folded_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
+    let mut by_edge: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let mut pairs = Vec::new();
+    for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+        if a == b || b == c || a == c {
+            continue;
+        }
+        for (u, v, w) in [(a, b, c), (b, c, a), (c, a, b)] {
+            let Some(&n) = by_edge.get(&(u.min(v), u.max(v))) else {
+                by_edge.insert((u.min(v), u.max(v)), t as u32);
+                continue;
+            };
+            let other = mesh.triangles[n as usize];
+            let Some(&x) = other.iter().find(|&&x| x != u && x != v) else { continue };
+            let p = |i: u32| mesh.positions[i as usize].as_dvec3();
+            if folded_across_edge(p(v) - p(u), p(w) - p(u), p(x) - p(u)) {
+                pairs.push([n, t as u32]);
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,6 +140,24 @@ mod tests {
             &[[0, 1, 2], [0, 3, 4]],
         );
         assert_eq!(self_intersections(&spread), 0);
+    }
+
+    /// The pleat DMC made on the rotated box: a triangle flipped in the plane of its neighbour,
+    /// tilted out of it by rounding. Folded within a degree counts; a sharp but open edge does not.
+    #[test]
+    fn a_triangle_folded_onto_its_neighbour_across_an_edge_is_found() {
+        let across = |d: [f32; 3]| {
+            mesh(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.3, 1.0, 0.0], d], &[[0, 1, 2], [1, 0, 3]])
+        };
+        assert_eq!(folded_pairs(&across([0.6, 0.8, 1e-5])), vec![[0, 1]]);
+        assert_eq!(folded_pairs(&across([0.6, 0.8, -1e-3])), vec![[0, 1]]);
+        assert_eq!(self_intersections(&across([0.6, 0.8, 1e-5])), 0, "a fold crosses nothing");
+        assert!(folded_pairs(&across([0.6, -0.8, 0.0])).is_empty(), "flat continuation");
+        assert!(folded_pairs(&across([0.6, 0.8, 0.1])).is_empty(), "a 7° edge is sharp, not folded");
+        assert!(folded_pairs(&across([0.6, 1e-4, 1e-6])).is_empty(), "a sliver has no reliable side");
+        for m in [tetrahedron(), octahedron(), cube()] {
+            assert!(folded_pairs(&m).is_empty());
+        }
     }
 
     #[test]

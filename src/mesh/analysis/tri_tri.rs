@@ -83,6 +83,24 @@ pub fn overlap_beyond_shared_vertex(a: &[DVec3; 2], b: &[DVec3; 2]) -> bool {
     [line, -line].iter().any(|&d| in_closed_wedge(a, na, d) && in_closed_wedge(b, nb, d))
 }
 
+/// Triangles lying on top of each other across a shared edge closer than this are folded.
+pub const FOLD_DEG: f64 = 1.0;
+
+/// Whether triangles `(0, e, c)` and `(0, e, d)`, which share the edge from the origin to `e`
+/// (translate first), are folded onto each other: both on the same side of the edge, their
+/// half-planes within [`FOLD_DEG`]. Across an edge, two triangles meet only along it unless they
+/// fold; an exact test would miss the folds DMC makes (its vertices lie on the planes of the
+/// primitives, and `f32` rounding tilts a triangle flipped in such a plane by 1e-4°). Triangles
+/// thinner than 1e-3 of the edge have no reliable side and never count.
+pub fn folded_across_edge(e: DVec3, c: DVec3, d: DVec3) -> bool {
+    let (nc, nd) = (e.cross(c), e.cross(d));
+    let thin = 1e-3 * e.length_squared();
+    if nc.length() <= thin || nd.length() <= thin {
+        return false;
+    }
+    nc.dot(nd) > FOLD_DEG.to_radians().cos() * nc.length() * nd.length()
+}
+
 /// Normalised sines of the angles from the first side ray to `x` and from `x` to the second, both
 /// measured around the wedge's normal `n = r[0] x r[1]`: both positive inside the wedge.
 fn wedge_sines(r: &[DVec3; 2], n: DVec3, x: DVec3) -> (f64, f64) {
