@@ -289,4 +289,38 @@ mod tests {
         let s = qef.minimise_in_box(Vec3::new(1.0, -1.0, -1.0), hi, None);
         assert_eq!(s.position.x, 1.0);
     }
+
+    #[test]
+    fn the_truncated_minimiser_leaves_a_cone_edge_few_samples_see() {
+        // The rounded thin room's floor edge (y = 0.8, z = -0.5), seen from the leaf beside the +y
+        // wall that dips 0.004 below the floor (depth 3 of `thin_room`): the field is the distance
+        // to the box minus 0.008, a plane above the floor's level and a cone around the edge below,
+        // and every tangent plane of its graph passes through (edge, -0.008). Only the lowest layer
+        // of samples sees the cone, so that direction's singular value (1e-6 of the largest) falls
+        // under the cutoff: the minimiser keeps the reference's height, although the edge lies in
+        // the (grown) box and fits exactly. Following such weak directions was measured and not
+        // kept (README, "The rounded room"): it took the rounded room from 1048 to 1036 triangles
+        // but put the rotated box's outside vertices on its edges (depth 5: 1454 triangles, 0.0086,
+        // normal p95 0.2° became 1684, 0.0136, 44.9°).
+        let (lo, hi) = (Vec3::new(0.021, 0.8085, -0.504), Vec3::new(0.2835, 1.071, -0.2415));
+        let mut qef = Qef::new((lo + hi) * 0.5);
+        let edge = |p: Vec3| Vec3::new(0.0, p.y - 0.8, (p.z + 0.5).min(0.0));
+        // As the octree samples: 4 per axis, the first and last on the cell's faces.
+        for k in 0..4 {
+            for j in 0..4 {
+                for i in 0..4 {
+                    let p = lo + (hi - lo) * Vec3::new(i as f32, j as f32, k as f32) / 3.0;
+                    qef.add(p, edge(p).length() - 0.008, edge(p).normalize());
+                }
+            }
+        }
+        let reach = (hi - lo) * 0.25;
+        let s = qef.minimise_in_box(lo - reach, hi + reach, None);
+        let on_edge = DVec3::new(s.position.x, 0.8, -0.5);
+        let x = on_edge - qef.origin;
+        let w = qef.best_w(x);
+        let exact = qef.rms(qef.error_local(&Vector4::new(x.x, x.y, x.z, w)));
+        assert!(exact < 1e-6 && (w + 0.008).abs() < 1e-6, "{exact} {w}");
+        assert!(s.rms > 1e-4 && (s.position.z + 0.5).abs() > 0.02, "{s:?}");
+    }
 }
