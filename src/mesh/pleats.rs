@@ -1,17 +1,15 @@
 //! Pleats: a triangle turned over inside a flat part of the surface, lying on the neighbours it
 //! shares its edges with. Where DMC's dual vertices lie on one plane of a primitive (a box's face),
-//! Marching Cubes on a flat dual cell can fold a triangle back over its neighbours; where EMC's fan
-//! centres and crossings all lie on a crease that bounds a flat face (the rocket's bottom rim at
-//! 40 cells), chords between them can fold too. The mesh stays closed and consistently oriented
-//! and crosses nothing, but a face points into the solid: a dark triangle on the rotated box's
-//! face at depth 6, 0.08 long (found by [`crate::mesh::analysis::self_intersecting_pairs`], which
-//! counts triangles folded onto each other across an edge).
+//! Marching Cubes on a flat dual cell can fold a triangle back over its neighbours. The mesh stays
+//! closed and consistently oriented and crosses nothing, but a face points into the solid: a dark
+//! triangle on the rotated box's face at depth 6, 0.08 long (found by
+//! [`crate::mesh::analysis::folded_pairs`]).
 //!
 //! The turned-over triangle and the neighbours folded onto it make one flat disc whose boundary,
 //! walked along the neighbours' orientation, is a simple polygon; triangulating that polygon again
 //! removes the fold without moving the surface or changing its topology. Where the boundary is not
-//! simple (a lone folded pair is a bow tie) the pleat is left alone, to be counted (DMC's
-//! refinement then treats it as an intersection).
+//! simple (a lone folded pair is a bow tie, as are EMC's folds on the rocket's rim) the pleat is
+//! left alone, to be counted (DMC's refinement then treats it as an intersection).
 
 use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
