@@ -1,6 +1,7 @@
 //! The edge-flipping pass of EMC (§4.3): after the fans are in, flip every edge whose two opposite
 //! vertices are feature points, so feature lines become explicit chains of mesh edges.
 
+use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
 use glam::Vec3;
 use std::collections::HashMap;
@@ -60,6 +61,24 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool], on_feature: &[
             continue;
         }
         if new1.dot(mesh.normals[a as usize]) <= 0.0 || new2.dot(mesh.normals[b as usize]) <= 0.0 {
+            continue;
+        }
+        // Where the non-feature vertices lie on the crease themselves (a rim in a grid plane),
+        // their normals are perpendicular to a flat face's triangles and the test above cannot
+        // see those turn over: refuse a flip whose new triangles fold onto each other or onto a
+        // neighbour.
+        let d64 = |v: u32| p(v).as_dvec3();
+        let folds_onto_neighbour = |u: u32, v: u32, w: u32| {
+            directed.get(&(v, u)).is_some_and(|&n| {
+                let x = opposite(mesh.triangles[n as usize], u, v);
+                folded_across_edge(d64(v) - d64(u), d64(w) - d64(u), d64(x) - d64(u))
+            })
+        };
+        if folded_across_edge(d64(d) - d64(c), d64(a) - d64(c), d64(b) - d64(c))
+            || [(c, a, d), (a, d, c), (d, b, c), (b, c, d)]
+                .iter()
+                .any(|&(u, v, w)| folds_onto_neighbour(u, v, w))
+        {
             continue;
         }
         mesh.triangles[t1 as usize] = [c, a, d];

@@ -26,6 +26,7 @@
 
 use super::feature::{crease_direction, FeatureKind};
 use crate::grid::in_box;
+use crate::mesh::analysis::tri_tri::folded_across_edge;
 use glam::Vec3;
 
 /// How far (in cells) points placed in the cell stay off its faces.
@@ -205,13 +206,27 @@ fn search_line(p: Vec3, dir: Vec3, bounds: (Vec3, Vec3), valid: impl Fn(Vec3) ->
 }
 
 /// A fan around `center` is valid when every triangle faces the way the field's normals at its
-/// two polygon vertices do (no fold-over) and none is degenerate.
+/// two polygon vertices do (no fold-over) and none is degenerate. Where those normals are nearly
+/// perpendicular to the triangle, they cannot tell which way it faces: polygon vertices on a crease
+/// that bounds a flat face (the rocket's bottom rim at 40 cells lies in a grid plane) carry the
+/// side's normal while the triangle lies in the face. Such a triangle must also not fold onto
+/// its neighbours in the fan (on the rim, chords between points of the circle folded).
 fn fan_is_valid(center: Vec3, pts: &[Vec3], nrm: &[Vec3]) -> bool {
-    (0..pts.len()).all(|q| {
-        let r = (q + 1) % pts.len();
-        let n = (pts[q] - center).cross(pts[r] - center);
+    let n = pts.len();
+    let rel = |p: Vec3| (p - center).as_dvec3();
+    (0..n).all(|q| {
+        let r = (q + 1) % n;
+        let normal = (pts[q] - center).cross(pts[r] - center);
         let scale = (pts[q] - center).length() * (pts[r] - center).length();
-        n.length() > 1e-6 * scale && n.dot(nrm[q] + nrm[r]) > 0.0
+        let reference = nrm[q] + nrm[r];
+        let facing = normal.dot(reference);
+        let blind = facing < 0.2 * normal.length() * reference.length();
+        let folds = || {
+            let (before, after) = ((q + n - 1) % n, (r + 1) % n);
+            folded_across_edge(rel(pts[q]), rel(pts[r]), rel(pts[before]))
+                || folded_across_edge(rel(pts[r]), rel(pts[q]), rel(pts[after]))
+        };
+        normal.length() > 1e-6 * scale && facing > 0.0 && !(blind && folds())
     })
 }
 

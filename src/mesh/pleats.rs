@@ -8,8 +8,8 @@
 //! The turned-over triangle and the neighbours folded onto it make one flat disc whose boundary,
 //! walked along the neighbours' orientation, is a simple polygon; triangulating that polygon again
 //! removes the fold without moving the surface or changing its topology. Where the boundary is not
-//! simple (a lone folded pair is a bow tie, as are EMC's folds on the rocket's rim) the pleat is
-//! left alone, to be counted (DMC's refinement then treats it as an intersection).
+//! simple (a lone folded pair is a bow tie) the pleat is left alone, to be counted (DMC's
+//! refinement then treats it as an intersection).
 
 use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
