@@ -85,8 +85,13 @@ fn unpleat_once(mesh_mut: &mut Mesh, per_triangle: Option<&mut Vec<u32>>) -> usi
         while region.len() <= MAX_REGION {
             let triangles: Vec<[u32; 3]> = region.iter().map(|&r| mesh.triangles[r]).collect();
             if let Some(new) = retriangulate(&triangles, up, &position, by_edge, &region) {
-                for &r in &region {
-                    touched[r] = true;
+                // Every triangle at one of the disc's corners waits for the next pass, so that no
+                // other disc of this pass can add a diagonal between the same two corners.
+                let corners: HashSet<u32> = triangles.iter().flatten().copied().collect();
+                for (other, tri) in mesh.triangles.iter().enumerate() {
+                    if tri.iter().any(|v| corners.contains(v)) {
+                        touched[other] = true;
+                    }
                 }
                 replacements.push((region, new));
                 break;
