@@ -17,28 +17,44 @@ type Column = [f32; LANES];
 
 /// Values at many points; only the first `min(points.len(), out.len())` are written.
 pub fn eval_columns(tape: &Tape, points: &[Vec3], out: &mut [f32]) {
+    run_columns(tape, points, out, |v, _| v, run_column, |&v| v);
+}
+
+/// Runs `tape` over `points`, 64 at a time, in the number system `D`: inputs made by `input`
+/// from a coordinate and its axis, each instruction run over a column by `step`, and `result` of
+/// the output written to `out` (the first `min(points.len(), out.len())` entries).
+fn run_columns<D: Domain, O>(
+    tape: &Tape,
+    points: &[Vec3],
+    out: &mut [O],
+    input: impl Fn(f32, usize) -> D,
+    step: impl Fn(&Instr, &mut [[D; LANES]]),
+    result: impl Fn(&D) -> O,
+) {
     let n = points.len().min(out.len());
     if n == 0 {
         return;
     }
-    let mut cols: Vec<Column> = vec![[0.0; LANES]; tape.slot_count];
+    let mut cols: Vec<[D; LANES]> = vec![[D::default(); LANES]; tape.slot_count];
     for (col, &c) in cols.iter_mut().zip(&tape.consts) {
-        col.fill(c);
+        col.fill(D::constant(c));
     }
     for start in (0..n).step_by(LANES) {
         let chunk = &points[start..n.min(start + LANES)];
-        for (axis, input) in tape.inputs.iter().enumerate() {
-            if let Some(s) = input {
+        for (axis, input_slot) in tape.inputs.iter().enumerate() {
+            if let Some(s) = input_slot {
                 let col = &mut cols[*s as usize];
                 for (c, p) in col.iter_mut().zip(chunk) {
-                    *c = p[axis];
+                    *c = input(p[axis], axis);
                 }
             }
         }
         for instr in &tape.instrs {
-            run_column(instr, &mut cols);
+            step(instr, &mut cols);
         }
-        out[start..start + chunk.len()].copy_from_slice(&cols[tape.output as usize][..chunk.len()]);
+        for (o, v) in out[start..start + chunk.len()].iter_mut().zip(&cols[tape.output as usize]) {
+            *o = result(v);
+        }
     }
 }
 
@@ -89,34 +105,11 @@ fn run_column(instr: &Instr, cols: &mut [Column]) {
 
 type DualColumn = [Dual; LANES];
 
-/// Gradients at many points (see [`super::eval::eval_gradient`] for the conventions at kinks);
-/// only the first `min(points.len(), out.len())` are written.
-pub fn eval_gradient_columns(tape: &Tape, points: &[Vec3], out: &mut [Vec3]) {
-    let n = points.len().min(out.len());
-    if n == 0 {
-        return;
-    }
-    let mut cols: Vec<DualColumn> = vec![[Dual::default(); LANES]; tape.slot_count];
-    for (col, &c) in cols.iter_mut().zip(&tape.consts) {
-        col.fill(Dual::constant(c));
-    }
-    for start in (0..n).step_by(LANES) {
-        let chunk = &points[start..n.min(start + LANES)];
-        for (axis, input) in tape.inputs.iter().enumerate() {
-            if let Some(s) = input {
-                let col = &mut cols[*s as usize];
-                for (c, p) in col.iter_mut().zip(chunk) {
-                    *c = Dual::input(p[axis], axis);
-                }
-            }
-        }
-        for instr in &tape.instrs {
-            run_dual_column(instr, &mut cols);
-        }
-        for (o, d) in out[start..start + chunk.len()].iter_mut().zip(&cols[tape.output as usize]) {
-            *o = d.d;
-        }
-    }
+/// Gradients at many points (see [`super::eval::eval_gradient`] for the conventions at kinks),
+/// each passed through `wrap` (callers that want `Option`s need no second buffer); only the
+/// first `min(points.len(), out.len())` are written.
+pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wrap: impl Fn(Vec3) -> O) {
+    run_columns(tape, points, out, Dual::input, run_dual_column, |d| wrap(d.d));
 }
 
 /// One instruction over a column of duals. Each arm names its operation as a constant, so that

@@ -18,11 +18,7 @@ impl Field for Program {
     }
 
     fn gradients(&self, points: &[Vec3], out: &mut [Option<Vec3>]) {
-        let mut exact = vec![Vec3::ZERO; points.len().min(out.len())];
-        self.eval_grad_many(points, &mut exact);
-        for (o, g) in out.iter_mut().zip(exact) {
-            *o = Some(g);
-        }
+        self.eval_grad_many_as(points, out, Some);
     }
 
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {

@@ -87,7 +87,12 @@ impl Program {
     /// Gradients at many points, 64 at a time, bit for bit [`Program::eval_grad`]'s. Writes
     /// `min(points.len(), out.len())` gradients.
     pub fn eval_grad_many(&self, points: &[Vec3], out: &mut [Vec3]) {
-        eval_gradient_columns(&self.tape, points, out);
+        eval_gradient_columns(&self.tape, points, out, |g| g);
+    }
+
+    /// [`Program::eval_grad_many`] with each gradient passed through `wrap`.
+    pub(super) fn eval_grad_many_as<O>(&self, points: &[Vec3], out: &mut [O], wrap: impl Fn(Vec3) -> O) {
+        eval_gradient_columns(&self.tape, points, out, wrap);
     }
 
     /// A shorter program equal to this one wherever `choices` hold (typically inside the box

@@ -112,7 +112,8 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         for corner in corners {
             record(&projector.project((centroid + corner) * 0.5));
         }
-        let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
+        let twice_area = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+        let normal = twice_area.normalize_or_zero();
         let gradient = projector.gradient(on_surface.point).normalize_or_zero();
         if normal != DVec3::ZERO && gradient != DVec3::ZERO {
             let angle = normal.cross(gradient).length().atan2(normal.dot(gradient)).to_degrees();
@@ -122,8 +123,7 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
                 .iter()
                 .any(|&(i, j)| n[i] != DVec3::ZERO && n[j] != DVec3::ZERO && n[i].dot(n[j]) < crease_cos);
             if at_crease {
-                let area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length() * 0.5;
-                crease_deviations.push((angle, area));
+                crease_deviations.push((angle, twice_area.length() * 0.5));
             }
         }
     }
