@@ -22,6 +22,17 @@ fn dmc_mesh(field: &dyn Field, min: Vec3, max: Vec3, options: &DmcOptions) -> (M
     (mesh, stats)
 }
 
+/// The room's promise: closed, manifold, outward, intersection-free, Euler 2, one part, fewer than
+/// `most` triangles, and max distance within 1 % of the room's 1.6.
+fn assert_room(mesh: &Mesh, field: &dyn Field, what: &str, most: usize) {
+    let topo = assert_watertight(mesh, what);
+    assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+    let tris = mesh.triangle_count();
+    assert!(tris < most, "{what}: {tris} triangles");
+    let error = analysis::surface_error(mesh, field);
+    assert!(error.dist_max < 0.01 * 1.6, "{what}: max distance {}", error.dist_max);
+}
+
 /// The target, with `vertex_reach` 0.25 (vertices may follow their QEF minimiser a quarter
 /// of their leaf out of it) and `tolerance` 0.01: the planar room in < 1 000 triangles (954) within
 /// 1 % of its size (0.0112, 0.7 %), closed, manifold, outward, intersection-free, Euler 2, one
@@ -36,12 +47,7 @@ fn planar_thin_room_within_1_percent_under_1000_triangles_with_vertex_reach() {
             DmcOptions { max_depth: depth, tolerance: 0.01, vertex_reach: 0.25, ..DmcOptions::default() };
         let (mesh, _) = dmc_mesh(&field, min, max, &options);
         let what = format!("planar room, vertex reach 0.25, depth {depth}");
-        let topo = assert_watertight(&mesh, &what);
-        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
-        let tris = mesh.triangle_count();
-        assert!(tris < 1_000, "{what}: {tris} triangles");
-        let error = analysis::surface_error(&mesh, &field);
-        assert!(error.dist_max < 0.01 * 1.6, "{what}: max distance {}", error.dist_max);
+        assert_room(&mesh, &field, &what, 1_000);
         let (full, _) = dmc_mesh(&field, min, max, &DmcOptions { prune: false, ..options });
         assert_eq!((&mesh.triangles, &mesh.positions), (&full.triangles, &full.positions), "{what}: pruning");
     }
@@ -88,12 +94,7 @@ fn rounded_thin_room_within_1_percent_with_vertex_reach() {
             DmcOptions { max_depth: depth, tolerance: 0.01, vertex_reach: 0.25, ..DmcOptions::default() };
         let (mesh, _) = dmc_mesh(field, scene.min, scene.max, &options);
         let what = format!("rounded room, vertex reach 0.25, depth {depth}");
-        let topo = assert_watertight(&mesh, &what);
-        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
-        let tris = mesh.triangle_count();
-        assert!(tris < 1_100, "{what}: {tris} triangles");
-        let error = analysis::surface_error(&mesh, field);
-        assert!(error.dist_max < 0.01 * 1.6, "{what}: max distance {}", error.dist_max);
+        assert_room(&mesh, field, &what, 1_100);
         let (full, _) = dmc_mesh(field, scene.min, scene.max, &DmcOptions { prune: false, ..options });
         assert_eq!((&mesh.triangles, &mesh.positions), (&full.triangles, &full.positions), "{what}: pruning");
     }
@@ -118,12 +119,7 @@ fn both_rooms_within_1_percent_under_1000_triangles_with_one_recipe() {
                 DmcOptions { max_depth: depth, tolerance: 0.02, vertex_reach: 0.5, ..DmcOptions::default() };
             let (mesh, _) = dmc_mesh(field, min, max, &options);
             let what = format!("{name} room, tolerance 0.02, vertex reach 0.5, depth {depth}");
-            let topo = assert_watertight(&mesh, &what);
-            assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
-            let tris = mesh.triangle_count();
-            assert!(tris < 1_000, "{what}: {tris} triangles");
-            let error = analysis::surface_error(&mesh, field);
-            assert!(error.dist_max < 0.01 * 1.6, "{what}: max distance {}", error.dist_max);
+            assert_room(&mesh, field, &what, 1_000);
         }
     }
 }
