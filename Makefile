@@ -1,5 +1,5 @@
 # The two commands a newcomer needs; both install what is missing first and are safe to re-run.
-.PHONY: demo test setup wasm bench
+.PHONY: demo test setup wasm bench soak
 demo:   ## set up, build the wasm package, serve the demo on http://localhost:8080/
 	./scripts/demo.sh
 test:   ## every test: fmt, clippy (native + wasm32), cargo test, wasm-bindgen-test in Chromium, browser tests
@@ -10,3 +10,5 @@ wasm:
 	./scripts/build-wasm.sh
 bench:
 	cargo bench
+soak:   ## the seeded property suites (every test named prop_*) with ISOFORGE_SOAK cases each (default 2000); not in CI
+	ISOFORGE_SOAK=$${ISOFORGE_SOAK:-2000} cargo test -- prop_

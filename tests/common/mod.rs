@@ -38,6 +38,22 @@ impl Rng {
     }
 }
 
+/// How many seeded cases a property suite runs: `ci` in `cargo test` (sized for CI on a 2-core
+/// machine), or `ISOFORGE_SOAK` of them in a soak (`make soak`). Cases are numbered from 0; the
+/// seed of case `n` is `seed_base + n`, printed on failure, and `ISOFORGE_SEED=S` runs that one
+/// case alone.
+pub fn case_seeds(seed_base: u64, ci: usize) -> Vec<u64> {
+    let var = |name: &str| std::env::var(name).ok().and_then(|v| v.trim().parse::<u64>().ok());
+    if cfg!(target_arch = "wasm32") {
+        return (0..ci as u64).map(|n| seed_base + n).collect();
+    }
+    if let Some(seed) = var("ISOFORGE_SEED") {
+        return vec![seed];
+    }
+    let count = var("ISOFORGE_SOAK").map_or(ci as u64, |n| n.max(1));
+    (0..count).map(|n| seed_base + n).collect()
+}
+
 /// Asserts the properties every closed output must have, with a message naming what broke.
 pub fn assert_watertight(mesh: &Mesh, what: &str) -> analysis::Topology {
     let topo = analysis::topology(mesh);
