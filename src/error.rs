@@ -22,6 +22,9 @@ pub enum Error {
     /// something unknown. `line` and `column` are 1-based (column counts characters); `snippet`
     /// is the whole offending source line, so the message stands alone.
     Parse { message: String, line: usize, column: usize, snippet: String },
+    /// A vertex came out infinite or NaN although every input was finite: the samples or
+    /// coordinates are so large that the method's `f32` arithmetic overflowed.
+    NonFiniteOutput { method: &'static str, index: usize, position: [f32; 3] },
     /// A user-supplied field function (see [`crate::field::BatchFn`]) failed or returned a batch
     /// of the wrong size.
     FieldFunction(String),
@@ -46,6 +49,12 @@ impl fmt::Display for Error {
             }
             Error::Io(msg) => write!(f, "{msg}"),
             Error::FieldFunction(msg) => write!(f, "field function: {msg}"),
+            Error::NonFiniteOutput { method, index, position } => write!(
+                f,
+                "{method} produced vertex {index} at ({}, {}, {}): the input's values or coordinates are too \
+                 large for f32 arithmetic; scale them down",
+                position[0], position[1], position[2]
+            ),
             Error::Parse { message, line, column, snippet } => {
                 write!(f, "{line}:{column}: {message}\n{snippet}\n")?;
                 // Copy tabs from the line so the caret lands under the same column in a terminal.

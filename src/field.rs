@@ -206,7 +206,8 @@ pub fn sample_grid(field: &dyn Field, grid: &Grid) -> Result<Vec<f32>, Error> {
     Ok(values)
 }
 
-/// Fails with [`Error::NonFiniteSample`] naming the first NaN or infinite sample.
+/// Fails with [`Error::NonFiniteSample`] naming the first NaN or infinite sample, and with
+/// [`Error::InvalidGrid`] for the first past [`MAX_SAMPLE_MAGNITUDE`].
 pub fn check_finite(values: &[f32], grid: &Grid) -> Result<(), Error> {
     if values.len() != grid.point_count() {
         let p = grid.points();
@@ -227,8 +228,21 @@ pub fn check_finite(values: &[f32], grid: &Grid) -> Result<(), Error> {
             value: values[n],
         });
     }
+    if let Some(n) = values.iter().position(|v| v.abs() > MAX_SAMPLE_MAGNITUDE) {
+        let [i, j, k] = grid.unindex(n);
+        return Err(Error::InvalidGrid(format!(
+            "sample ({i}, {j}, {k}) is {}; samples must lie within ±{MAX_SAMPLE_MAGNITUDE:e} so that \
+             differences and slopes between them stay finite in f32 (scale the volume down)",
+            values[n]
+        )));
+    }
     Ok(())
 }
+
+/// Largest sample magnitude accepted: differences of two samples, and their slopes over cells
+/// down to 1e-8 wide, stay finite in `f32`. No physical volume comes near it; a value past it is
+/// a corrupt file or a hostile one.
+pub const MAX_SAMPLE_MAGNITUDE: f32 = 1e30;
 
 /// Which gradient a [`SampledField`] reports.
 ///

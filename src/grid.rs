@@ -13,6 +13,24 @@ pub fn in_box(p: Vec3, (lo, hi): (Vec3, Vec3)) -> bool {
 /// well inside a browser tab's memory (about 300 MB of samples at the cap).
 pub const DEFAULT_MAX_CELLS: u64 = 72_000_000;
 
+/// Most cells along one axis of any grid: 2^21, so that every count of points or cells fits in
+/// 64 bits and every index along an axis is exact in `f32`.
+pub const MAX_CELLS_PER_AXIS: usize = 1 << 21;
+
+/// Largest coordinate any grid may reach: a triangle's area and normal take products of two
+/// edge lengths and the volume products of three, which must stay finite in `f32`.
+pub const MAX_COORDINATE: f32 = 1e12;
+
+/// Representable `f32` positions a cell must span along each axis: vertices sit as close as 1e-3
+/// of an edge to its ends ([`crate::mc::MIN_EDGE_FRACTION`]), which needs about a thousand.
+pub const MIN_ULPS_PER_CELL: f32 = 1024.0;
+
+/// The gap between `x` (≥ 0, finite) and the next larger `f32`.
+fn f32_ulp(x: f32) -> f32 {
+    let x = x.max(f32::MIN_POSITIVE);
+    f32::from_bits(x.to_bits() + 1) - x
+}
+
 /// A regular lattice of sample points: `cells[a] + 1` points along axis `a`, the first at `origin`,
 /// spaced by `spacing` (anisotropic spacing is allowed because CT and MRI stacks have it).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,7 +53,7 @@ impl Grid {
         let extent = max - min;
         let spacing =
             Vec3::new(extent.x / cells[0] as f32, extent.y / cells[1] as f32, extent.z / cells[2] as f32);
-        Ok(Grid { origin: min, spacing, cells })
+        Grid { origin: min, spacing, cells }.checked()
     }
 
     /// A grid with cubic cells, `res` of them along the longest side of the bounds. The other axes get
@@ -45,12 +63,17 @@ impl Grid {
         if res == 0 {
             return Err(Error::InvalidGrid("resolution must be at least 1 cell".into()));
         }
+        if res > MAX_CELLS_PER_AXIS {
+            return Err(Error::InvalidGrid(format!(
+                "resolution {res} is more than {MAX_CELLS_PER_AXIS} cells along an axis"
+            )));
+        }
         let extent = max - min;
         let h = extent.max_element() / res as f32;
         let cells = [0, 1, 2].map(|a| ((extent[a] / h) - 1e-4).ceil().max(1.0) as usize);
         let covered = Vec3::new(cells[0] as f32, cells[1] as f32, cells[2] as f32) * h;
         let origin = (min + max) * 0.5 - covered * 0.5;
-        Ok(Grid { origin, spacing: Vec3::splat(h), cells })
+        Grid { origin, spacing: Vec3::splat(h), cells }.checked()
     }
 
     /// A lattice of `points[a]` samples along axis `a` (at least 2), the first at `origin`, spaced
@@ -67,7 +90,45 @@ impl Grid {
                 "origin must be finite and spacing positive, got origin {origin}, spacing {spacing}"
             )));
         }
-        Ok(Grid { origin, spacing, cells: points.map(|n| n - 1) })
+        Grid { origin, spacing, cells: points.map(|n| n - 1) }.checked()
+    }
+
+    /// The checks every constructor ends with, so that no grid the library builds can overflow a
+    /// count, reach infinity, or have cells that `f32` cannot tell apart. Each is an error rather
+    /// than a clamp: a silently different grid would mesh a different surface.
+    fn checked(self) -> Result<Grid, Error> {
+        if self.cells.iter().any(|&c| c > MAX_CELLS_PER_AXIS) {
+            return Err(Error::InvalidGrid(format!(
+                "{} x {} x {} cells: at most {MAX_CELLS_PER_AXIS} cells along an axis",
+                self.cells[0], self.cells[1], self.cells[2]
+            )));
+        }
+        if self.points().iter().try_fold(1usize, |n, &p| n.checked_mul(p)).is_none() {
+            return Err(Error::GridTooLarge { cells: self.cell_count(), max_cells: usize::MAX as u64 });
+        }
+        let far = self.max();
+        if !(far.abs().max(self.origin.abs()).max_element() <= MAX_COORDINATE) {
+            return Err(Error::InvalidGrid(format!(
+                "the grid from {} spaced by {} reaches {far}; coordinates must lie within ±{MAX_COORDINATE:e} \
+                 so that areas, volumes and normals stay finite in f32",
+                self.origin, self.spacing
+            )));
+        }
+        for a in 0..3 {
+            let reach = self.origin[a].abs().max(far[a].abs());
+            let ulp = f32_ulp(reach);
+            if self.spacing[a] < MIN_ULPS_PER_CELL * ulp {
+                return Err(Error::InvalidGrid(format!(
+                    "cells of {} along {} at coordinates up to {reach} are finer than f32 can place \
+                     vertices in ({} representable positions per cell, at least {MIN_ULPS_PER_CELL} \
+                     needed); mesh the shape near the origin and move the mesh afterwards",
+                    self.spacing[a],
+                    ["x", "y", "z"][a],
+                    (self.spacing[a] / ulp).floor()
+                )));
+            }
+        }
+        Ok(self)
     }
 
     /// Sample points per axis.
@@ -80,8 +141,9 @@ impl Grid {
         p[0] * p[1] * p[2]
     }
 
+    /// Cells in the grid; saturates at `u64::MAX` (never wraps), so a size check cannot be fooled.
     pub fn cell_count(&self) -> u64 {
-        self.cells.iter().map(|&c| c as u64).product()
+        self.cells.iter().try_fold(1u64, |n, &c| n.checked_mul(c as u64)).unwrap_or(u64::MAX)
     }
 
     /// World position of sample point `(i, j, k)`.

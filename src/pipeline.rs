@@ -18,6 +18,7 @@ use crate::stats::{self, AnalysisOptions, Stats};
 use glam::Vec3;
 
 mod inputs;
+mod validate;
 pub use inputs::{mesh_points, mesh_triangles, MeshDistance, PlaneDistance};
 
 /// The meshing methods. Names are the CLI's `--method` and the wasm API's `method`.
@@ -278,7 +279,22 @@ impl Meshed {
         Meshed { quads: out.mesh.quads, quad_stages: out.stages, ..Meshed::plain(mesh, phases) }
     }
 
-    fn analyse(self, method: Method, res: usize, truth: &dyn Field, options: AnalysisOptions) -> Output {
+    /// The stats of the mesh, after the last check every output passes: coordinates that reached
+    /// infinity or NaN in the method's arithmetic (samples near `f32::MAX`, say) are an error, never
+    /// a mesh whose stats call it closed.
+    fn analyse(
+        self,
+        method: Method,
+        res: usize,
+        truth: &dyn Field,
+        options: AnalysisOptions,
+    ) -> Result<Output, Error> {
+        let bad_vertex = self.mesh.positions.iter().position(|p| !p.is_finite());
+        let bad_normal = self.mesh.normals.iter().position(|n| !n.is_finite());
+        if let Some(index) = bad_vertex.or(bad_normal) {
+            let position = self.mesh.positions[index].to_array();
+            return Err(Error::NonFiniteOutput { method: method.name(), index, position });
+        }
         let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
         stats.points_evaluated = self.evaluations.map(|e| e.0);
@@ -287,26 +303,30 @@ impl Meshed {
         stats.dual_cells = self.octree.map(|o| o.1);
         stats.quads = self.quads.len();
         stats.quad_stages = self.quad_stages;
-        Output { mesh: self.mesh, feature_edges: self.feature_edges, quads: self.quads, stats }
+        Ok(Output { mesh: self.mesh, feature_edges: self.feature_edges, quads: self.quads, stats })
     }
 }
 
 /// Meshes a field over `bounds` (unless the request overrides them).
 pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error> {
+    request.validate()?;
     let (min, max) = request.bounds.unwrap_or(bounds);
-    let grid = Grid::with_resolution(min, max, request.res)?;
+    // DMC's finest level is a grid too: the same precision and count checks hold for it.
+    let grid = Grid::with_resolution(min, max, request.reported_res())?;
+    if request.method != Method::Dmc {
+        grid.check_size(request.max_cells)?;
+    }
     let meshed = match request.method {
         Method::Mc => {
-            grid.check_size(request.max_cells)?;
             let (mesh, timings) = mc::mesh_field(field, &grid, &request.mc_options())?;
             Meshed::plain(mesh, timings.phases())
         }
         Method::Emc => {
-            grid.check_size(request.max_cells)?;
             let (out, timings) = emc::mesh_field(field, &grid, &request.emc_options())?;
             Meshed::from_emc(out, timings)
         }
-        // The octree bounds its own size (`max_cells` leaves); `res` only picks the default depth.
+        // The octree bounds its own work (see `DmcOptions::max_cells`); `res` only picks the
+        // default depth.
         Method::Dmc => {
             let (mesh, stats) = dmc::mesh_field(field, min, max, &request.dmc_options())?;
             Meshed::from_dmc(mesh, stats)
@@ -321,7 +341,7 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
         }
     };
     let shifted = Shifted { field, iso: request.iso };
-    Ok(meshed.analyse(request.method, request.reported_res(), &shifted, request.analysis))
+    meshed.analyse(request.method, request.reported_res(), &shifted, request.analysis)
 }
 
 /// Where programs (typed or CSG) are meshed unless the request names bounds: [-1, 1]³.
@@ -377,6 +397,9 @@ fn sampled_res(grid: &Grid, request: &Request) -> usize {
 /// the samples stands in for the true surface in the error statistics, its normals given by
 /// `request.gradient` (trilinear or interpolated central differences, see [`SampleGradient`]).
 pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Output, Error> {
+    request.validate()?;
+    // Before any method interpolates them: differences of samples near f32::MAX overflow.
+    crate::field::check_finite(values, grid)?;
     let meshed = match request.method {
         Method::Mc => {
             let (mesh, timings) = mc::mesh_samples(values, grid, &request.mc_options())?;
@@ -400,7 +423,7 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
-    Ok(meshed.analyse(request.method, sampled_res(grid, request), &shifted, request.analysis))
+    meshed.analyse(request.method, sampled_res(grid, request), &shifted, request.analysis)
 }
 
 /// Meshes a batch field function (the slow path for functions that are costly to call, such as
@@ -410,6 +433,7 @@ pub fn mesh_function<F>(field: &BatchFn<F>, bounds: (Vec3, Vec3), request: &Requ
 where
     F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>,
 {
+    request.validate()?;
     let (min, max) = request.bounds.unwrap_or(bounds);
     let grid = Grid::with_resolution(min, max, request.res)?;
     grid.check_size(request.max_cells)?;

@@ -21,6 +21,7 @@
 //! and the estimated distance of every triangle from the surface (refinement rule 3). `max_depth`
 //! caps the octree (`2^max_depth` finest cells along the longest side, the `res` reported).
 
+pub mod bounds;
 pub mod contour;
 pub mod dual;
 pub mod features;
@@ -65,7 +66,8 @@ pub struct DmcOptions {
     /// Skip cells whose interval bounds exclude the iso-level (fields that provide bounds only).
     /// The output is the same either way.
     pub prune: bool,
-    /// Refuse octrees with more leaves than this.
+    /// The work cap, in grid cells' worth of samples: octrees whose leaves would take more than
+    /// this many field samples (`samples_per_cell³` each) are refused.
     pub max_cells: u64,
     /// The paper's refinement only, for measurement: the octree is split by QEF residual alone
     /// (plus un-pruning and representing straddling leaves, `refine` rules 1 and 2); the accuracy,
@@ -118,7 +120,7 @@ impl Default for DmcOptions {
 }
 
 impl DmcOptions {
-    fn validate(&self) -> Result<(), Error> {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
         let bad = |msg: String| Err(Error::InvalidOption(msg));
         if !self.iso.is_finite() {
             return bad(format!("iso must be finite, got {}", self.iso));
@@ -186,7 +188,9 @@ pub fn octree_root(min: Vec3, max: Vec3, options: &DmcOptions) -> (Vec3, f32, Pa
         max_depth: options.max_depth,
         samples_per_cell: options.samples_per_cell,
         prune: options.prune,
-        max_leaves: options.max_cells,
+        // Each leaf is sampled `samples_per_cell³` times: the cap bounds the samples, as
+        // `max_cells` bounds the samples of a grid.
+        max_leaves: (options.max_cells / (options.samples_per_cell as u64).pow(3)).max(8),
         accuracy_rule: options.accuracy_rule,
         vertex_reach: options.vertex_reach,
     };
@@ -203,6 +207,8 @@ pub fn mesh_field(
 ) -> Result<(Mesh, DmcStats), Error> {
     options.validate()?;
     Grid::new(min, max, [1, 1, 1])?;
+    let clipped = bounds::Clipped { field, iso: options.iso, min, max };
+    let field: &dyn Field = &clipped;
     let (root_min, size, params) = octree_root(min, max, options);
     let mut stats = DmcStats::default();
     let t = Instant::now();

@@ -233,9 +233,10 @@ impl Octree {
         self.leaves += 7;
         if self.leaves > self.params.max_leaves {
             return Err(Error::InvalidOption(format!(
-                "the octree needs more than maxCells = {} leaves; raise the tolerance, lower the \
-                 maximum depth or raise maxCells",
-                self.params.max_leaves
+                "the octree needs more than {} leaves of {} samples each, more work than maxCells \
+                 allows; raise the tolerance, lower the maximum depth or raise maxCells",
+                self.params.max_leaves,
+                self.params.samples_per_cell.pow(3)
             )));
         }
         let first = self.nodes.len() as u32;

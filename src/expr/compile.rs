@@ -15,6 +15,7 @@ use super::builtins::Builtin;
 use super::diag::{Diag, Span};
 use super::graph::{Graph, NodeId, MAX_NODES};
 use super::ops::{BinaryOp, UnaryOp};
+use super::params;
 use super::parser::MAX_NESTING;
 use super::program::Program;
 use super::shapes::{self, Emit};
@@ -30,6 +31,13 @@ pub trait Backend: Emit {
         at: [Self::V; 3],
         depth: usize,
     ) -> Result<Self::V, Diag>;
+
+    /// The value of `v` where it is known when the program is built (a constant), so shape
+    /// parameters can be range-checked at the call; backends that only compute numbers at one
+    /// point know nothing ahead of evaluation.
+    fn known(&self, _v: Self::V) -> Option<f32> {
+        None
+    }
 
     /// Called after each call is lowered, so a runaway expansion stops early.
     fn check(&self, _span: Span) -> Result<(), Diag> {
@@ -93,6 +101,10 @@ pub fn lower<B: Backend>(
                 for a in args {
                     vals.push(lower(b, a, p)?);
                 }
+                let known: Vec<Option<f64>> = vals.iter().map(|&v| b.known(v).map(f64::from)).collect();
+                if let Some(message) = params::check(*f, &known) {
+                    return Err(Diag::new(expr.span, message));
+                }
                 apply(b, *f, &vals, p, expr.span)?
             };
             b.check(expr.span)?;
@@ -113,6 +125,11 @@ fn transform<B: Backend>(
     let mut params = Vec::with_capacity(args.len().saturating_sub(1));
     for a in args.iter().skip(1) {
         params.push(lower(b, script, a, p, depth)?);
+    }
+    let known: Vec<Option<f64>> =
+        std::iter::once(None).chain(params.iter().map(|&v| b.known(v).map(f64::from))).collect();
+    if let Some(message) = params::check(f, &known) {
+        return Err(Diag::new(span, message));
     }
     let at = match f {
         Builtin::Translate => shapes::translate(b, p, [params[0], params[1], params[2]]),
@@ -231,6 +248,10 @@ impl Backend for GraphBackend {
         let id = self.graph.substitute(built, at);
         self.moved.insert((index, at), id);
         Ok(id)
+    }
+
+    fn known(&self, v: NodeId) -> Option<f32> {
+        self.graph.as_constant(v)
     }
 
     fn check(&self, span: Span) -> Result<(), Diag> {

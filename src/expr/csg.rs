@@ -120,6 +120,14 @@ impl CsgNode {
         })
     }
 
+    /// Why this node's own parameters are out of range (see [`super::params::check`]), or `None`.
+    pub fn parameter_error(&self) -> Option<String> {
+        let (f, shapes, numbers) = parts(self);
+        let args: Vec<Option<f64>> =
+            shapes.iter().map(|_| None).chain(numbers.into_iter().map(Some)).collect();
+        super::params::check(f, &args)
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).unwrap_or_default()
     }

@@ -156,7 +156,11 @@ impl<'de> Visitor<'de> for NodeVisitor {
                 takes.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
             )));
         }
-        build(op, &mut fields)
+        let node = build(op, &mut fields)?;
+        match node.parameter_error() {
+            Some(message) => Err(de::Error::custom(message)),
+            None => Ok(node),
+        }
     }
 }
 

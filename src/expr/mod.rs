@@ -68,6 +68,7 @@ mod interval;
 mod lexer;
 pub mod naive;
 mod ops;
+mod params;
 mod parser;
 mod program;
 mod shapes;

@@ -97,6 +97,14 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, Error> {
         }
         push_fan(&polygon, &mut triangles);
     }
+    if let Some((n, _)) = lines.next() {
+        return Err(fail(
+            n,
+            format!(
+                "data after the declared {vertices} vertices and {faces} faces; the counts are too small"
+            ),
+        ));
+    }
     Ok(Mesh { positions, normals: Vec::new(), triangles })
 }
 

@@ -223,6 +223,11 @@ pub(super) fn read(bytes: &[u8]) -> Result<PlyData, Error> {
             vertex_count = Some(element.count);
         }
     }
+    if let Some(location) = source.leftover() {
+        return Err(Error::Io(format!(
+            "PLY has data after its declared elements{location}; the header's counts are too small"
+        )));
+    }
     if let Some((index, face)) = largest_index {
         let vertices = vertex_count.unwrap_or(0);
         if index >= vertices {
@@ -287,6 +292,26 @@ impl Source<'_> {
                 *pos = end;
                 Ok(ty.decode(raw, *big))
             }
+        }
+    }
+
+    /// Where data follows the last declared element, if any does (blank text does not count).
+    fn leftover(&mut self) -> Option<String> {
+        match self {
+            Source::Ascii { lines, tokens, line } => {
+                if tokens.next().is_some() {
+                    return Some(format!(" (line {line})"));
+                }
+                for l in lines.by_ref() {
+                    *line += 1;
+                    if !l.trim().is_empty() {
+                        return Some(format!(" (line {line})"));
+                    }
+                }
+                None
+            }
+            Source::Binary { bytes, pos, offset, .. } => (*pos < bytes.len())
+                .then(|| format!(" (byte {}, {} bytes left)", *pos + *offset, bytes.len() - *pos)),
         }
     }
 

@@ -36,9 +36,12 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh, Error> {
         )));
     };
     let needed = 84 + 50 * count;
-    if (bytes.len() as u64) < needed {
+    // A count that disagrees with the length either way means the header or the file is damaged;
+    // meshing the declared part would silently drop (or invent) triangles.
+    if bytes.len() as u64 != needed {
+        let room = (bytes.len() as u64).saturating_sub(84) / 50;
         return Err(Error::Io(format!(
-            "binary STL declares {count} triangles ({needed} bytes) but the file has {} bytes",
+            "binary STL declares {count} triangles ({needed} bytes) but the file has {} bytes (room for {room})",
             bytes.len()
         )));
     }
@@ -63,8 +66,9 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh, Error> {
     Ok(Mesh { positions: welder.positions, normals: Vec::new(), triangles })
 }
 
-/// ASCII STL, line by line: `solid`, then per facet `facet normal`, `outer loop`, `vertex x y z`
-/// (three or more: polygons are fan-triangulated), `endloop`, `endfacet`, and finally `endsolid`.
+/// ASCII STL, line by line: `solid`, then per facet `facet normal`, `outer loop`, three
+/// `vertex x y z` (the format has triangles only: a loop of four is a damaged file, not a quad),
+/// `endloop`, `endfacet`, and finally `endsolid`.
 /// Several solids in one file are read into one mesh.
 fn read_ascii(bytes: &[u8]) -> Result<Mesh, Error> {
     let text = String::from_utf8_lossy(bytes);
@@ -99,8 +103,8 @@ fn read_ascii(bytes: &[u8]) -> Result<Mesh, Error> {
             }
             "endloop" if loop_ids.is_some() => {
                 let ids = loop_ids.take().unwrap_or_default();
-                if ids.len() < 3 {
-                    return Err(fail(format!("facet has {} vertices; it needs at least 3", ids.len())));
+                if ids.len() != 3 {
+                    return Err(fail(format!("facet has {} vertices; STL facets are triangles", ids.len())));
                 }
                 push_fan(&ids, &mut triangles);
             }
@@ -170,5 +174,23 @@ mod tests {
         assert!(err.contains("line 1:"), "a truncated 'solid' file is read as ASCII: {err}");
         let err = read_binary(&bytes[..100]).unwrap_err().to_string();
         assert!(err.contains("declares 1 triangles"), "{err}");
+    }
+
+    #[test]
+    fn lying_counts_and_four_vertex_facets_are_refused() {
+        let mut bytes = vec![b' '; 80];
+        bytes.extend_from_slice(&1u32.to_le_bytes());
+        for _ in 0..2 {
+            for x in [0.0f32, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+            bytes.extend_from_slice(&[0, 0]);
+        }
+        let err = read(&bytes).unwrap_err().to_string();
+        assert!(err.contains("declares 1 triangles") && err.contains("room for 2"), "{err}");
+        let quad = TETRA.replacen("  vertex 1 0 0\n endloop", "  vertex 1 0 0\n  vertex 1 1 0\n endloop", 1);
+        assert_ne!(quad, TETRA);
+        let err = read(quad.as_bytes()).unwrap_err().to_string();
+        assert!(err.contains("facet has 4 vertices; STL facets are triangles"), "{err}");
     }
 }

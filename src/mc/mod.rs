@@ -52,6 +52,18 @@ impl Default for McOptions {
     }
 }
 
+impl McOptions {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
+        if !self.iso.is_finite() {
+            return Err(Error::InvalidOption(format!("iso must be finite, got {}", self.iso)));
+        }
+        if self.max_cells == 0 {
+            return Err(Error::InvalidOption("maxCells must be at least 1".into()));
+        }
+        Ok(())
+    }
+}
+
 /// Milliseconds spent in each phase of a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct McTimings {

@@ -48,6 +48,35 @@ impl Default for McqOptions {
     }
 }
 
+impl McqOptions {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
+        let bad = |msg: String| Err(Error::InvalidOption(msg));
+        if !self.iso.is_finite() {
+            return bad(format!("iso must be finite, got {}", self.iso));
+        }
+        if let Some(alpha) = self.snap {
+            // Past half a cell a vertex would be near two grid points at once.
+            if !(alpha > 0.0 && alpha < 0.5) {
+                return bad(format!("snap must be in (0, 0.5) cells, got {alpha}"));
+            }
+        }
+        // A polygon's angles sum to less than 180° per corner; past 90° every corner is "bad".
+        let cut = self.rules.cut_angle_deg;
+        if !(0.0..=90.0).contains(&cut) {
+            return bad(format!("cutAngle is in degrees and must lie in 0..=90, got {cut}"));
+        }
+        // A four-sided polygon's longest over shortest edge: 1 is a rhombus, below 1 never holds.
+        let ratio = self.rules.quad_ratio;
+        if !(ratio.is_finite() && ratio >= 1.0) {
+            return bad(format!("quadRatio must be finite and at least 1, got {ratio}"));
+        }
+        if self.max_cells == 0 {
+            return bad("maxCells must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
 /// Default snapping distance in cells (see the README's measurements).
 pub const DEFAULT_SNAP: f32 = 0.3;
 
@@ -117,12 +146,7 @@ fn extract(
     field: &dyn Field,
 ) -> Result<(Mesh, McqReport), Error> {
     check_finite(values, grid)?;
-    if let Some(alpha) = options.snap {
-        // Past half a cell a vertex would be near two grid points at once.
-        if !(alpha > 0.0 && alpha < 0.5) {
-            return Err(Error::InvalidOption(format!("snap must be in (0, 0.5) cells, got {alpha}")));
-        }
-    }
+    options.validate()?;
     let mut report = McqReport::default();
     let t = Instant::now();
     let mut positions = vec![];

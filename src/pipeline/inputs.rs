@@ -58,7 +58,9 @@ fn mesh_signed_values(
     })
 }
 
+/// The request's own checks, and an iso-level of 0: the surface is the input itself.
 fn iso_must_be_zero(request: &Request, what: &str) -> Result<(), Error> {
+    request.validate()?;
     if request.iso != 0.0 {
         return Err(Error::InvalidOption(format!("iso must be 0 when {what}, got {}", request.iso)));
     }
@@ -84,7 +86,7 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
         }
     };
     let res = sampled_res(&grid, request);
-    Ok(meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis))
+    meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis)
 }
 
 /// Reconstructs the surface an oriented point cloud samples (normals pointing out of the solid;
@@ -107,7 +109,7 @@ pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Erro
         }
     };
     let res = sampled_res(&grid, request);
-    Ok(meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis))
+    meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis)
 }
 
 /// Signed distance to a triangle mesh, the truth a remeshed mesh is measured against: the

@@ -2,6 +2,8 @@
 //! headless Chromium (each suite imports `wasm_bindgen_test as test` on wasm32).
 #![allow(dead_code)]
 
+pub mod csg;
+
 use isoforge::mesh::analysis;
 use isoforge::{Grid, Mesh, Vec3};
 
