@@ -93,6 +93,12 @@ fn can_collapse(
         return false;
     }
     let a_ring = ring(mesh, tris, a);
+    // Only a closed umbrella (as many neighbours as triangles) may move: a crossing on the mesh's
+    // border lies in a face of the grid's bounds, and collapsing it would pull the border inward,
+    // off the bounds the surface is clipped by (found by the random unpadded grids).
+    if a_ring.len() != tris.len() {
+        return false;
+    }
     if a_ring.iter().any(|&v| (p(v) - p(a)).dot(plane).abs() > tolerance) {
         return false;
     }

@@ -4,7 +4,7 @@
 
 use super::feature::FeatureKind;
 use super::placement;
-use crate::mc::polygon_center;
+use crate::mc::{polygon_center, untangled};
 use crate::mcq::polygon::triangulate_cell_polygon;
 use crate::mcq::PolygonRules;
 use crate::tables::{CellTriangles, CENTER};
@@ -66,7 +66,9 @@ impl Plan<'_> {
         if let Some(rules) = rules {
             return triangulate_cell_polygon(&self.ids, &self.pts, self.cell_edges, rules, EXTRA);
         }
-        let group = &table.edges[3 * self.group.start..3 * self.group.end];
+        let table_group = &table.edges[3 * self.group.start..3 * self.group.end];
+        let fan = untangled(self.cell_edges, table_group, |e| positions[self.by_edge[e as usize] as usize]);
+        let group = fan.as_deref().unwrap_or(table_group);
         let extra = group.contains(&CENTER).then(|| polygon_center(positions, group, &self.by_edge));
         let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
         (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)

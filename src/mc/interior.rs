@@ -195,12 +195,15 @@ pub fn tunnels(
 /// backwards, choosing the band of least total triangle `area` by dynamic programming over every
 /// starting rung (an edge from one rim to the other); the least-area band is the one that neither
 /// twists nor folds. A rung `rung_ok` refuses is never used; `None` if every band would need one. No
-/// rung may appear twice (a rim fanned to one vertex pinches the band).
+/// rung may appear twice (a rim fanned to one vertex pinches the band). Of the bands found (one
+/// per starting rung) the least-area one `band_ok` accepts is kept: on skewed rims the least-area
+/// band can fold over itself, and the caller's test says which bands cross.
 pub fn tube<T: Copy>(
     a: &[T],
     b: &[T],
     rung_ok: impl Fn(T, T) -> bool,
     area: impl Fn([T; 3]) -> f64,
+    band_ok: impl Fn(&[[T; 3]]) -> bool,
 ) -> Option<Vec<[T; 3]>> {
     let c: Vec<T> = b.iter().rev().copied().collect();
     let (n, m) = (a.len(), c.len());
@@ -253,7 +256,9 @@ pub fn tube<T: Copy>(
                     j -= 1;
                 }
             }
-            best = Some((score, out));
+            if band_ok(&out) {
+                best = Some((score, out));
+            }
         }
     }
     best.map(|(_, tris)| tris)
@@ -299,7 +304,8 @@ mod tests {
     fn a_tube_keeps_both_rims_in_their_direction_and_closes() {
         let a = [0, 1, 2];
         let b = [10, 11, 12, 13];
-        let tris = tube(&a, &b, |_, _| true, |t: [i32; 3]| (t[0] % 10 - t[2] % 10).abs() as f64).unwrap();
+        let tris =
+            tube(&a, &b, |_, _| true, |t: [i32; 3]| (t[0] % 10 - t[2] % 10).abs() as f64, |_| true).unwrap();
         assert_eq!(tris.len(), 7);
         let mut directed = std::collections::HashMap::new();
         for t in &tris {

@@ -11,12 +11,13 @@
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
+use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use crate::mesh::Mesh;
 use crate::tables::{
-    polygon_table_with_faces, triangle_table, triangle_table_with_faces, triangulate_polygon, CellTriangles,
-    CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
+    polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, triangulate_polygon,
+    CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
 };
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use web_time::Instant;
 
 pub mod interior;
@@ -222,11 +223,17 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
                 &with_faces[(case as usize) << 6 | joined as usize]
             }
         };
+        let polygons = match options.topology {
+            Topology::Fixed => &polygon_table()[case as usize],
+            Topology::Trilinear => {
+                &polygon_table_with_faces()[(case as usize) << 6 | joined_faces(case, d) as usize]
+            }
+        };
         let mut at = 0;
-        for &count in tris.per_polygon.iter().take_while(|&&c| c > 0) {
+        for (poly, &count) in polygons.iter().zip(&tris.per_polygon) {
             let group = &tris.edges[3 * at..3 * (at + count as usize)];
             at += count as usize;
-            cell.emit_polygon(group, cache, &mut mesh);
+            cell.emit_untangled(poly, group, cache, &mut mesh);
         }
     });
     Ok(mesh)
@@ -356,6 +363,19 @@ impl Cell<'_> {
         }
     }
 
+    /// One polygon by the table's triangles `group`, or fanned around its centre where two of
+    /// those cross (see [`untangled`]).
+    fn emit_untangled(&mut self, poly: &[u8], group: &[u8], cache: &mut EdgeCache, mesh: &mut Mesh) {
+        // In the table's order, as `emit_polygon` would create them: the output stays the same
+        // vertex for vertex where the table's triangles are kept.
+        for &e in group.iter().chain(poly).filter(|&&e| e != CENTER) {
+            self.vertex(e, cache, mesh);
+        }
+        let ids = self.ids;
+        let fan = untangled(poly, group, |e| mesh.positions[ids[e as usize] as usize]);
+        self.emit_polygon(fan.as_deref().unwrap_or(group), cache, mesh);
+    }
+
     /// A cell whose interior joins what its faces keep apart: the joined polygons become tubes.
     fn emit_with_tunnels(
         &mut self,
@@ -370,7 +390,7 @@ impl Cell<'_> {
         let all: Vec<&[u8]> = polygons.iter().collect();
         for k in rest {
             let group: Vec<u8> = triangulate_polygon(all[k]).concat();
-            self.emit_polygon(&group, cache, mesh);
+            self.emit_untangled(all[k], &group, cache, mesh);
         }
         for (a, b) in tubes {
             for e in all[a].iter().chain(all[b]) {
@@ -382,17 +402,49 @@ impl Cell<'_> {
                 let [p, q, r] = t.map(|e| positions[ids[e as usize] as usize]);
                 (q - p).cross(r - p).length() as f64
             };
-            match interior::tube(all[a], all[b], |_, _| true, area) {
+            let uncrossed = |band: &[[u8; 3]]| {
+                let tris: Vec<([u32; 3], [DVec3; 3])> = band
+                    .iter()
+                    .map(|t| (t.map(u32::from), t.map(|e| positions[ids[e as usize] as usize].as_dvec3())))
+                    .collect();
+                !any_pair_crosses(&tris)
+            };
+            match interior::tube(all[a], all[b], |_, _| true, area, uncrossed) {
                 Some(band) => mesh.triangles.extend(band.iter().map(|t| t.map(|e| ids[e as usize]))),
                 None => {
                     for k in [a, b] {
                         let group: Vec<u8> = triangulate_polygon(all[k]).concat();
-                        self.emit_polygon(&group, cache, mesh);
+                        self.emit_untangled(all[k], &group, cache, mesh);
                     }
                 }
             }
         }
     }
+}
+
+/// `None` when the table's triangles `group` of polygon `poly` (edge ids, vertex positions by
+/// `at`) do not cross one another; else the fan of `poly` around its centre ([`CENTER`]), in
+/// table form. A skew polygon whose vertices sit near opposite ends of their edges (coarse or
+/// random samples) can fold the table's diagonals over each other, and no fixed choice of
+/// diagonals avoids that for every position. The fan cannot cross itself: seen from a point
+/// strictly inside the convex cell, each fan triangle lies in the cone over its polygon edge, and
+/// the polygon's edges lie in the cell's faces and meet only at their shared vertices, so two fan
+/// triangles meet only along their common edge. Tables that fan already are left as they are.
+pub(crate) fn untangled(poly: &[u8], group: &[u8], at: impl Fn(u8) -> Vec3) -> Option<Vec<u8>> {
+    if group.contains(&CENTER) || group.len() <= 3 {
+        return None;
+    }
+    let tris: Vec<([u32; 3], [DVec3; 3])> = group
+        .chunks_exact(3)
+        .map(|t| ([t[0], t[1], t[2]].map(u32::from), [t[0], t[1], t[2]].map(|e| at(e).as_dvec3())))
+        .collect();
+    any_pair_crosses(&tris)
+        .then(|| (0..poly.len()).flat_map(|k| [CENTER, poly[k], poly[(k + 1) % poly.len()]]).collect())
+}
+
+/// Do two of `tris` (ids, corners) cross, by the self-intersection checker's rules?
+fn any_pair_crosses(tris: &[([u32; 3], [DVec3; 3])]) -> bool {
+    (0..tris.len()).any(|s| (s + 1..tris.len()).any(|t| indexed_pair_intersects(tris[s], tris[t])))
 }
 
 /// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.

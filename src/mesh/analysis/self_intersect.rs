@@ -51,7 +51,14 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
 
 /// Whether triangles `s` and `t` of `mesh` intersect, by the rules of this module.
 pub fn triangle_pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
-    let (ts, tt) = (mesh.triangles[s], mesh.triangles[t]);
+    let corners = |t: usize| mesh.corners(t).map(|p| p.as_dvec3());
+    indexed_pair_intersects((mesh.triangles[s], corners(s)), (mesh.triangles[t], corners(t)))
+}
+
+/// [`triangle_pair_intersects`] for two triangles given by their vertex ids and corners, so that a
+/// mesher can ask it of triangles it has not written yet.
+pub fn indexed_pair_intersects(s: ([u32; 3], [DVec3; 3]), t: ([u32; 3], [DVec3; 3])) -> bool {
+    let ((ts, a), (tt, b)) = (s, t);
     let mut shared = None;
     let mut count = 0;
     for (i, v) in ts.iter().enumerate() {
@@ -60,11 +67,9 @@ pub fn triangle_pair_intersects(mesh: &Mesh, s: usize, t: usize) -> bool {
             count += 1;
         }
     }
-    let corners = |t: usize| mesh.corners(t).map(|p| p.as_dvec3());
     match (count, shared) {
-        (0, _) => triangles_intersect(&corners(s), &corners(t)),
+        (0, _) => triangles_intersect(&a, &b),
         (1, Some((i, j))) => {
-            let (a, b) = (corners(s), corners(t));
             let rest = |c: [DVec3; 3], k: usize| [c[(k + 1) % 3] - c[k], c[(k + 2) % 3] - c[k]];
             overlap_beyond_shared_vertex(&rest(a, i), &rest(b, j))
         }

@@ -1,0 +1,460 @@
+//! Seeded random sampled grids for the grid methods (MC with both topologies, EMC, MCQ), checked
+//! against what the README promises for each: grids nobody chose, of every shape the generators
+//! below can think of, rather than the eleven scenes the other suites know by heart.
+//!
+//! A failing case prints its seed; `ISOFORGE_SEED=S cargo test --test props_grids` reruns it alone
+//! and `ISOFORGE_SOAK=N` runs N cases per property (see `common::case_seeds`). Shrunk failures live
+//! at the bottom as named regression tests with their values written out.
+
+mod common;
+
+use common::{case_seeds, Rng};
+use isoforge::mc::Topology;
+use isoforge::mesh::analysis;
+use isoforge::pipeline::{self, Method, Request};
+use isoforge::{Grid, Mesh, Vec3};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
+
+/// The kinds of sample sets the generator draws from; each reaches a different corner of the
+/// methods (ties at the level, tiny and huge edge fractions, smooth shapes, quantised volumes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    /// Uniform in [-1, 1], level 0.
+    Uniform,
+    /// Uniform, but no sample within 0.2 of the level: every crossing sits well inside its edge.
+    Gap,
+    /// Unions and differences of balls and boxes (signed distances), level 0.
+    Shapes,
+    /// Values from {-1, 0, 1} / levels: many samples exactly at the level (0), which is outside.
+    AtLevel,
+    /// u8-like integers 0..=255, level an integer or half way between two.
+    Bytes,
+    /// u16-like integers, level an integer or half way between two.
+    Words,
+}
+
+const KINDS: [Kind; 6] = [Kind::Uniform, Kind::Gap, Kind::Shapes, Kind::AtLevel, Kind::Bytes, Kind::Words];
+
+/// One generated input.
+#[derive(Debug, Clone)]
+struct Case {
+    grid: Grid,
+    values: Vec<f32>,
+    iso: f32,
+    /// The border layer of samples is outside (>= the level), so every output must be closed.
+    padded: bool,
+    kind: Kind,
+}
+
+impl Case {
+    fn describe(&self) -> String {
+        format!(
+            "{:?}, {} points, origin {}, spacing {}, iso {}, padded {}",
+            self.kind,
+            self.grid.points().map(|n| n.to_string()).join("x"),
+            self.grid.origin,
+            self.grid.spacing,
+            self.iso,
+            self.padded
+        )
+    }
+}
+
+/// A random grid of 3–`max_points` points per axis, with non-cubic spacing and an origin away
+/// from zero, filled with one [`Kind`] of values and padded on half of the seeds.
+fn generate(seed: u64, max_points: usize) -> Case {
+    let mut rng = Rng::new(seed);
+    let points: [usize; 3] = std::array::from_fn(|_| 3 + rng.below(max_points as u64 - 2) as usize);
+    let spacing = Vec3::new(rng.range(0.2, 3.0), rng.range(0.2, 3.0), rng.range(0.2, 3.0));
+    let origin = Vec3::new(rng.range(-10.0, 10.0), rng.range(-10.0, 10.0), rng.range(-10.0, 10.0));
+    let grid = Grid::from_points(points, origin, spacing).unwrap();
+    let kind = KINDS[rng.below(KINDS.len() as u64) as usize];
+    let padded = rng.below(2) == 0;
+    let (mut values, iso) = match kind {
+        Kind::Uniform => (fill(&grid, |_| rng.range(-1.0, 1.0)), 0.0),
+        Kind::Gap => {
+            let values = fill(&grid, |_| {
+                let magnitude = rng.range(0.2, 1.0);
+                if rng.below(2) == 0 {
+                    magnitude
+                } else {
+                    -magnitude
+                }
+            });
+            (values, 0.0)
+        }
+        Kind::Shapes => (shapes(&grid, &mut rng), 0.0),
+        Kind::AtLevel => {
+            let levels = (1 + rng.below(3)) as f32;
+            (fill(&grid, |_| (rng.range(-1.0, 1.0) * levels).round() / levels), 0.0)
+        }
+        Kind::Bytes | Kind::Words => {
+            // A narrow band of integers makes ties at an integer level common; the full range
+            // gives the huge edge fractions of real volumes.
+            let top = match (kind, rng.below(2)) {
+                (Kind::Bytes, 0) => 255.0,
+                (Kind::Words, 0) => 65535.0,
+                _ => (1 + rng.below(6)) as f32,
+            };
+            let values = fill(&grid, |_| (rng.range(0.0, 1.0) * top).round());
+            let level = (rng.range(0.0, 1.0) * top).round().max(1.0);
+            let iso = if rng.below(2) == 0 { level } else { level - 0.5 };
+            (values, iso)
+        }
+    };
+    if padded {
+        // Outside means >= the level; a border exactly at the level is outside too and must give
+        // the same closed surface.
+        let outside = if rng.below(4) == 0 { iso } else { iso + 1.0 };
+        for (n, v) in values.iter_mut().enumerate() {
+            let ijk = grid.unindex(n);
+            if (0..3).any(|a| ijk[a] == 0 || ijk[a] == grid.cells[a]) {
+                *v = outside;
+            }
+        }
+    }
+    Case { grid, values, iso, padded, kind }
+}
+
+fn fill(grid: &Grid, mut value: impl FnMut(usize) -> f32) -> Vec<f32> {
+    (0..grid.point_count()).map(&mut value).collect()
+}
+
+/// Signed distances of 1–5 balls and boxes somewhere over the grid, each added to or cut from the
+/// union of those before it.
+fn shapes(grid: &Grid, rng: &mut Rng) -> Vec<f32> {
+    let (lo, hi) = (grid.origin, grid.max());
+    let cell = grid.spacing.min_element();
+    let count = 1 + rng.below(5);
+    let parts: Vec<(bool, bool, Vec3, Vec3)> = (0..count)
+        .map(|k| {
+            let centre = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
+            let size = Vec3::new(rng.range(0.4, 4.0), rng.range(0.4, 4.0), rng.range(0.4, 4.0)) * cell;
+            (rng.below(2) == 0, k > 0 && rng.below(3) == 0, centre, size)
+        })
+        .collect();
+    fill(grid, |n| {
+        let [i, j, k] = grid.unindex(n);
+        let p = grid.position(i, j, k);
+        let mut value = f32::INFINITY;
+        for &(ball, cut, centre, size) in &parts {
+            let d = if ball {
+                (p - centre).length() - size.x
+            } else {
+                let q = (p - centre).abs() - size;
+                q.max(Vec3::ZERO).length() + q.max_element().min(0.0)
+            };
+            value = if cut { value.max(-d) } else { value.min(d) };
+        }
+        value
+    })
+}
+
+fn request(method: Method, topology: Topology, iso: f32) -> Request {
+    Request { method, topology, iso, ..Request::default() }
+}
+
+fn mesh(case: &Case, method: Method, topology: Topology) -> Mesh {
+    let out = pipeline::mesh_samples(&case.values, &case.grid, &request(method, topology, case.iso));
+    out.unwrap_or_else(|e| panic!("{method:?}: {}: {e}", case.describe())).mesh
+}
+
+/// Is cell `c` crossed (its corners on both sides of the level)?
+fn crossed(case: &Case, c: [usize; 3]) -> bool {
+    let inside = |di: usize, dj: usize, dk: usize| {
+        case.values[case.grid.index(c[0] + di, c[1] + dj, c[2] + dk)] < case.iso
+    };
+    let first = inside(0, 0, 0);
+    (0..8).any(|n| inside(n & 1, (n >> 1) & 1, n >> 2) != first)
+}
+
+/// Does `p` lie in a crossed cell grown by `margin` cells on every side?
+fn in_crossed_cell(case: &Case, p: Vec3, margin: f32) -> bool {
+    let local = (p - case.grid.origin) / case.grid.spacing;
+    let eps = 1e-3;
+    let range = |a: usize| {
+        let lo = (local[a] - 1.0 - margin - eps).ceil().max(0.0) as usize;
+        let hi = ((local[a] + margin + eps).floor().max(0.0) as usize).min(case.grid.cells[a] - 1);
+        lo..=hi
+    };
+    range(0).any(|i| range(1).any(|j| range(2).any(|k| crossed(case, [i, j, k]))))
+}
+
+/// Does `p` lie on a grid edge whose ends are on opposite sides, at least 0.1 % of the edge from
+/// either end (MC's vertices, README: "one vertex per intersected grid edge")?
+fn on_crossed_edge(case: &Case, p: Vec3) -> bool {
+    let local = (p - case.grid.origin) / case.grid.spacing;
+    let near = |x: f32| (x - x.round()).abs() < 1e-3;
+    let Some(axis) = (0..3).find(|&a| !near(local[a])) else { return false };
+    if (0..3).any(|a| a != axis && !near(local[a])) {
+        return false;
+    }
+    let mut lo = local.round().to_array().map(|x| x.max(0.0) as usize);
+    lo[axis] = local[axis].floor().max(0.0) as usize;
+    if (0..3).any(|a| lo[a] > case.grid.cells[a]) || lo[axis] >= case.grid.cells[axis] {
+        return false;
+    }
+    let mut hi = lo;
+    hi[axis] += 1;
+    let inside = |c: [usize; 3]| case.values[case.grid.index(c[0], c[1], c[2])] < case.iso;
+    let t = local[axis] - lo[axis] as f32;
+    inside(lo) != inside(hi) && (0.999e-3..=1.0 - 0.999e-3).contains(&t)
+}
+
+/// Does the boundary edge `a`–`b` lie in one face of the grid's box?
+fn on_one_bounding_face(grid: &Grid, a: Vec3, b: Vec3) -> bool {
+    let (lo, hi) = (grid.origin, grid.max());
+    let tol = grid.spacing * 1e-3;
+    (0..3).any(|axis| {
+        let at = |p: Vec3, x: f32| (p[axis] - x).abs() <= tol[axis];
+        (at(a, lo[axis]) && at(b, lo[axis])) || (at(a, hi[axis]) && at(b, hi[axis]))
+    })
+}
+
+/// Edges used by exactly one triangle.
+fn boundary_edges(mesh: &Mesh) -> Vec<[u32; 2]> {
+    let mut count = std::collections::HashMap::new();
+    for t in &mesh.triangles {
+        for q in 0..3 {
+            let (a, b) = (t[q], t[(q + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    count.into_iter().filter(|&(_, n)| n == 1).map(|((a, b), _)| [a, b]).collect()
+}
+
+/// What every grid method promises on every grid: finite coordinates, an oriented 2-manifold
+/// without degenerate or crossing triangles, closed on padded grids (outward, positive volume),
+/// and on unpadded ones open only where the surface meets the grid's bounds. Returns the topology,
+/// or what broke.
+fn check_sound(case: &Case, mesh: &Mesh, intersections: bool) -> Result<analysis::Topology, String> {
+    if !mesh.positions.iter().all(|p| p.is_finite()) {
+        return Err("non-finite vertex".into());
+    }
+    let topo = analysis::topology(mesh);
+    if topo.degenerate_triangles > 0 {
+        return Err(format!("{} degenerate triangles", topo.degenerate_triangles));
+    }
+    if (topo.non_manifold_edges, topo.non_manifold_vertices, topo.misoriented_edges) != (0, 0, 0) {
+        return Err(format!(
+            "not manifold: {} non-manifold edges, {} non-manifold vertices, {} misoriented edges",
+            topo.non_manifold_edges, topo.non_manifold_vertices, topo.misoriented_edges
+        ));
+    }
+    let crossings = if intersections { analysis::self_intersecting_pairs(mesh) } else { vec![] };
+    if let Some(first) = crossings.first() {
+        return Err(format!("self-intersections: {} pairs, first {first:?}", crossings.len()));
+    }
+    if case.padded {
+        if topo.boundary_edges > 0 {
+            return Err(format!("open on a padded grid: {} border edges", topo.boundary_edges));
+        }
+        if mesh.triangle_count() > 0 && analysis::signed_volume(mesh) <= 0.0 {
+            return Err("not oriented outward".into());
+        }
+    } else {
+        for [a, b] in boundary_edges(mesh) {
+            let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+            if !on_one_bounding_face(&case.grid, pa, pb) {
+                return Err(format!("border edge {pa} {pb} inside the grid"));
+            }
+        }
+    }
+    Ok(topo)
+}
+
+fn assert_sound(case: &Case, mesh: &Mesh, what: &str) -> analysis::Topology {
+    check_sound(case, mesh, true).unwrap_or_else(|e| panic!("{what}: {}: {e}", case.describe()))
+}
+
+const CI_CASES: usize = 120;
+
+/// Runs `check` on every seeded case (see `common::case_seeds`).
+fn for_cases(seed_base: u64, max_points: usize, mut check: impl FnMut(u64, &Case)) {
+    for seed in case_seeds(seed_base, CI_CASES) {
+        check(seed, &generate(seed, max_points));
+    }
+}
+
+/// MC, fixed table: sound, and every vertex on a crossed grid edge, at least 0.1 % of the edge
+/// from its ends, or (the centre of a polygon fanned because its table diagonals would fold)
+/// inside a crossed cell.
+#[test]
+fn prop_mc_fixed_is_a_closed_manifold() {
+    for_cases(1_000_000, 16, |seed, case| {
+        let mesh = mesh(case, Method::Mc, Topology::Fixed);
+        let what = format!("seed {seed} mc fixed");
+        assert_sound(case, &mesh, &what);
+        for &p in &mesh.positions {
+            assert!(
+                on_crossed_edge(case, p) || in_crossed_cell(case, p, 0.0),
+                "{what}: {}: vertex {p} neither on a crossed edge nor in a crossed cell",
+                case.describe()
+            );
+        }
+    });
+}
+
+/// MC, trilinear topology: sound, and every vertex on a crossed edge or (a polygon's centre
+/// vertex, a tube's vertices are edge vertices) inside a crossed cell.
+#[test]
+fn prop_mc_trilinear_is_a_closed_manifold() {
+    for_cases(2_000_000, 16, |seed, case| {
+        let mesh = mesh(case, Method::Mc, Topology::Trilinear);
+        let what = format!("seed {seed} mc trilinear");
+        assert_sound(case, &mesh, &what);
+        for &p in &mesh.positions {
+            assert!(
+                on_crossed_edge(case, p) || in_crossed_cell(case, p, 0.0),
+                "{what}: {}: vertex {p} outside every crossed cell",
+                case.describe()
+            );
+        }
+    });
+}
+
+/// EMC's promises apart from self-intersections (see [`prop_emc_does_not_cross_itself`]): an
+/// oriented manifold, closed on padded grids and open only on the bounds on unpadded ones, MC's
+/// Euler characteristic (fixed table), and every vertex in a crossed cell or at most half a cell
+/// outside it (README: a fan centre may sit "up to half a cell out"). Both topologies, and the
+/// better-triangles option.
+#[test]
+fn prop_emc_is_a_manifold_with_mcs_topology() {
+    for_cases(3_000_000, 16, |seed, case| {
+        let mc = analysis::topology(&mesh(case, Method::Mc, Topology::Fixed));
+        for (topology, better_triangles) in
+            [(Topology::Fixed, false), (Topology::Trilinear, false), (Topology::Fixed, true)]
+        {
+            let what = format!("seed {seed} emc {topology:?} better triangles {better_triangles}");
+            let req = Request { better_triangles, ..request(Method::Emc, topology, case.iso) };
+            let out = pipeline::mesh_samples(&case.values, &case.grid, &req);
+            let mesh = out.unwrap_or_else(|e| panic!("{what}: {}: {e}", case.describe())).mesh;
+            let topo = check_sound(case, &mesh, false)
+                .unwrap_or_else(|e| panic!("{what}: {}: {e}", case.describe()));
+            // With the trilinear option EMC takes the faces' decisions, MC the interior's too.
+            if topology == Topology::Fixed {
+                assert_eq!(
+                    topo.euler,
+                    mc.euler,
+                    "{what}: {}: Euler characteristic against MC",
+                    case.describe()
+                );
+            }
+            for &p in &mesh.positions {
+                assert!(
+                    in_crossed_cell(case, p, 0.5),
+                    "{what}: {}: vertex {p} more than half a cell from every crossed cell",
+                    case.describe()
+                );
+            }
+        }
+    });
+}
+
+/// EMC free of self-intersections on random grids, as issue 15 asks. Fails today on about half
+/// of these grids (fans of two components of one cell, and flips between fan centres, cross;
+/// see the README's Extended Marching Cubes limits), so it is left out of CI until that is fixed.
+#[test]
+#[ignore = "EMC still self-intersects on random grids (issue 15)"]
+fn prop_emc_does_not_cross_itself() {
+    for_cases(3_500_000, 16, |seed, case| {
+        for topology in [Topology::Fixed, Topology::Trilinear] {
+            let mesh = mesh(case, Method::Emc, topology);
+            assert_sound(case, &mesh, &format!("seed {seed} emc {topology:?}"));
+        }
+    });
+}
+
+/// MCQ: an oriented manifold (closed on padded grids), MC's Euler characteristic and components
+/// (snapping is checked edge collapses), and every vertex within the snapping distance (0.3
+/// cells) of a crossed cell. Self-intersections apart: [`prop_mcq_does_not_cross_itself`].
+#[test]
+fn prop_mcq_is_a_manifold_with_mcs_topology() {
+    for_cases(5_000_000, 16, |seed, case| {
+        let mesh = mesh(case, Method::Mcq, Topology::Fixed);
+        let what = format!("seed {seed} mcq");
+        let topo =
+            check_sound(case, &mesh, false).unwrap_or_else(|e| panic!("{what}: {}: {e}", case.describe()));
+        let mc = analysis::topology(&self::mesh(case, Method::Mc, Topology::Fixed));
+        assert_eq!(
+            (topo.euler, topo.components),
+            (mc.euler, mc.components),
+            "{what}: {}: Euler characteristic and components against MC",
+            case.describe()
+        );
+        for &p in &mesh.positions {
+            assert!(
+                in_crossed_cell(case, p, 0.3),
+                "{what}: {}: vertex {p} more than the snapping distance from every crossed cell",
+                case.describe()
+            );
+        }
+    });
+}
+
+/// MCQ free of self-intersections. Fails on about one random grid in 300 (seed 5000003, a
+/// u16-like 13x15x4 grid: 4 crossing pairs that the `uncross` pass leaves), so not in CI yet.
+#[test]
+#[ignore = "MCQ self-intersects on about 1 in 300 random grids (issue 15)"]
+fn prop_mcq_does_not_cross_itself() {
+    for_cases(5_000_000, 16, |seed, case| {
+        assert_sound(case, &mesh(case, Method::Mcq, Topology::Fixed), &format!("seed {seed} mcq"));
+    });
+}
+
+/// One cell of `values` (corners in `isoforge::tables::CORNERS` order) as a 2x2x2 grid.
+fn one_cell(origin: [f32; 3], spacing: [f32; 3], values: [f32; 8], iso: f32) -> Case {
+    let grid = Grid::from_points([2, 2, 2], Vec3::from(origin), Vec3::from(spacing)).unwrap();
+    Case { grid, values: values.to_vec(), iso, padded: false, kind: Kind::Words }
+}
+
+/// Shrunk from seed 5 of `survey` (a u16-like 7x8x5 grid's cell): five inside corners, the table's
+/// heptagon so skew (vertices at 0.3 % and 93 % of their edges) that its diagonals folded over
+/// one another. Now fanned around its centre, which cannot fold.
+#[test]
+fn mc_fixed_fans_a_skew_heptagon_whose_diagonals_fold() {
+    let case = one_cell(
+        [13.536472, 4.579759, -0.20526898],
+        [0.47815025, 0.7262882, 1.265705],
+        [3781.0, 55618.0, 26496.0, 2571.0, 24207.0, 13258.0, 48792.0, 24867.0],
+        26421.5,
+    );
+    let mesh = mesh(&case, Method::Mc, Topology::Fixed);
+    let topo = assert_sound(&case, &mesh, "skew heptagon");
+    assert_eq!((topo.components, topo.euler), (1, 1), "one disc");
+    assert!(mesh.positions.iter().any(|&p| !on_crossed_edge(&case, p)), "fanned around a centre vertex");
+}
+
+/// Shrunk from a random u16-like grid: a cell whose interior joins two polygons into a tube, where
+/// the least-area band folded over itself. The least-area band that does not is taken, so the
+/// tunnel (the interpolant's topology: one annulus) stays.
+#[test]
+fn mc_trilinear_tube_takes_the_least_area_band_that_does_not_fold() {
+    let case = one_cell(
+        [10.18942, 8.937489, 9.920371],
+        [0.47815025, 0.7262882, 1.265705],
+        [21277.0, 41298.0, 17436.0, 13785.0, 32254.0, 6145.0, 60406.0, 18557.0],
+        26421.5,
+    );
+    let mesh = mesh(&case, Method::Mc, Topology::Trilinear);
+    let topo = assert_sound(&case, &mesh, "tube");
+    assert_eq!((topo.components, topo.euler), (1, 0), "one annulus");
+}
+
+/// Shrunk from a random grid with no sample near the level: four separated inside corners (every
+/// face ambiguous), whose trilinear polygons' table triangles crossed.
+#[test]
+fn mc_trilinear_four_separated_corners_do_not_cross() {
+    let case = one_cell(
+        [26.203289, 18.680737, 15.178265],
+        [2.5569701, 2.5976343, 2.8570726],
+        [0.8, -0.76, -0.8, 0.5, -0.23339763, 0.2318964, 0.92, -0.91],
+        0.0,
+    );
+    assert_sound(&case, &mesh(&case, Method::Mc, Topology::Trilinear), "four corners");
+    assert_sound(&case, &mesh(&case, Method::Mc, Topology::Fixed), "four corners, fixed");
+}
