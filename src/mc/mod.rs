@@ -384,7 +384,7 @@ impl Cell<'_> {
 }
 
 /// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.
-fn edge_point(grid: &Grid, cell: [usize; 3], e: usize, d: &[f32; 8]) -> Vec3 {
+pub(crate) fn edge_point(grid: &Grid, cell: [usize; 3], e: usize, d: &[f32; 8]) -> Vec3 {
     let [a, b] = EDGES[e];
     let (da, db) = (d[a as usize], d[b as usize]);
     let t = (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
