@@ -30,7 +30,7 @@ pub enum Method {
     Dmc,
     /// Marching Cubes with the per-cell triangle-quality rules of issue 7 (see [`crate::mcq`]).
     Mcq,
-    /// Semi-regular quad mesh from the outside faces of cut cells, collapsed and subdivided.
+    /// Semi-regular quad mesh: the dual of MC's polygon mesh, collapsed and subdivided.
     Quad,
 }
 
@@ -150,6 +150,10 @@ impl Default for Request {
 impl Request {
     fn mc_options(&self) -> McOptions {
         McOptions { iso: self.iso, topology: self.topology, max_cells: self.max_cells }
+    }
+
+    fn quad_options(&self) -> QuadOptions {
+        QuadOptions { max_cells: self.max_cells, ..self.quad }
     }
 
     fn dmc_options(&self) -> DmcOptions {
@@ -336,7 +340,8 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
             Meshed::plain(mesh, report.phases())
         }
         Method::Quad => {
-            let (out, phases) = quad::mesh_field(&Shifted { field, iso: request.iso }, &grid, &request.quad)?;
+            let shifted = Shifted { field, iso: request.iso };
+            let (out, phases) = quad::mesh_field(&shifted, &grid, &request.quad_options())?;
             Meshed::from_quad(out, phases)
         }
     };
@@ -415,9 +420,16 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
             Meshed::plain(mesh, report.phases())
         }
         Method::Quad => {
+            // The samples minus the iso-level, as MC computes them, so the signs are MC's exactly.
+            crate::field::check_finite(values, grid)?;
             let field = SampledField { grid: *grid, values, gradient: request.gradient };
-            let (out, phases) =
-                quad::mesh_field(&Shifted { field: &field, iso: request.iso }, grid, &request.quad)?;
+            let shifted: Vec<f32> = values.iter().map(|v| v - request.iso).collect();
+            let (out, phases) = quad::mesh_samples(
+                &shifted,
+                &Shifted { field: &field, iso: request.iso },
+                grid,
+                &request.quad_options(),
+            )?;
             Meshed::from_quad(out, phases)
         }
     };

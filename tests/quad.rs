@@ -29,7 +29,7 @@ fn request(res: usize) -> Request {
 /// the output and the Euler characteristic of plain MC on the same grid.
 fn quad_scene(name: &str, res: usize) -> (Output, i64) {
     let out = pipeline::mesh_scene(name, &request(res)).unwrap();
-    let quads = QuadMesh { positions: out.mesh.positions.clone(), quads: out.quads.clone() };
+    let quads = QuadMesh::new(out.mesh.positions.clone(), out.quads.clone());
     assert!(quads.is_closed_manifold(), "{name}: quad mesh not a closed 2-manifold");
     assert_eq!(out.mesh.triangle_count(), 2 * quads.quad_count(), "{name}: two triangles per quad");
     // The independent triangle-mesh checker must agree on the triangulation.
@@ -101,10 +101,83 @@ fn each_stage_is_measured_and_stats_count_the_quads() {
     assert_eq!(names[..2], ["extracted", "projected"]);
     assert!(names.contains(&"local") && names.last().unwrap().starts_with("subdivided"));
     let extracted = &out.stats.quad_stages[0];
-    // Unprojected, vertices are grid points of cells the surface cuts: within a cell diagonal.
-    assert!(extracted.dist_max < 2.0 * 3f64.sqrt() / 16.0 && extracted.dist_max > 1e-3);
-    assert!(extracted.aspect_max < 1.0 + 1e-4, "octree faces are squares");
+    // Unprojected, vertices are centroids of MC polygons, inside the cells the surface cuts: within
+    // a cell diagonal of the surface, and not on it.
+    assert!(extracted.dist_max < 2.0 * 3f64.sqrt() / 16.0 && extracted.dist_max > 1e-4);
+    assert_eq!(extracted.held_back, 0, "the extraction is valid as it comes");
     assert!(out.stats.quad_stages.iter().all(|s| s.aspect_mean >= 1.0 && s.aspect_max.is_finite()));
     assert!(out.mesh.positions.iter().all(|p| p.is_finite() && p.abs().max_element() <= 1.0));
     let _ = Vec3::ZERO;
+}
+
+/// Quad and MC on the same grid: (Euler characteristic, components, closed) of each, after the
+/// checks every quad output must pass wherever it ends (manifold, finite, no crossings or folds).
+fn quad_and_mc(program: &str, res: usize) -> ((i64, usize, bool), (i64, usize, bool)) {
+    let out = pipeline::mesh_expr(program, &request(res)).unwrap();
+    let quads = QuadMesh::new(out.mesh.positions.clone(), out.quads.clone());
+    assert!(quads.is_manifold(), "{program}: not a 2-manifold");
+    assert!(out.mesh.positions.iter().all(|p| p.is_finite()), "{program}");
+    assert_eq!(analysis::self_intersections(&out.mesh), 0, "{program}: self-intersections");
+    assert!(analysis::folded_pairs(&out.mesh).is_empty(), "{program}: folds");
+    let mc_out = pipeline::mesh_expr(program, &Request { method: Method::Mc, ..request(res) }).unwrap();
+    let summary = |m: &isoforge::Mesh| {
+        let t = analysis::topology(m);
+        (t.euler, t.components, t.boundary_edges == 0)
+    };
+    (summary(&out.mesh), summary(&mc_out.mesh))
+}
+
+/// Issue 15: `--expr x` panicked (index out of bounds in the extraction). The plane reaches the
+/// bounds on four sides; like MC's, the quad mesh is a disc cut open there (χ = 1).
+#[test]
+fn a_plane_through_the_bounds_is_a_disc_cut_open_as_mc_cuts_it() {
+    let (quad, mc) = quad_and_mc("x", 16);
+    assert_eq!(quad, mc);
+    assert_eq!(quad, (1, 1, false));
+}
+
+/// Issue 15: `sphere(1.2)` (larger than the bounds' inscribed ball) panicked too. In [-1, 1]³ it is
+/// the sphere with its six caps beyond the cube's faces cut off: one piece, χ = 2 − 6 = −4.
+#[test]
+fn a_sphere_past_the_bounds_has_mcs_topology() {
+    let (quad, mc) = quad_and_mc("sphere(1.2)", 24);
+    assert_eq!(quad, mc);
+    assert!(!quad.2, "cut open by the bounds");
+}
+
+/// Issue 15: eight disjoint balls close together became one genus-5 surface (the old extraction
+/// joined cells touching along an edge). Gaps of 0.02 at res 20 (cells of 0.1) are below a cell.
+#[test]
+fn eight_disjoint_balls_close_together_stay_eight_spheres() {
+    let balls: Vec<String> = (0..8)
+        .map(|k| {
+            let c = [k & 1, (k >> 1) & 1, k >> 2].map(|b| if b == 1 { 0.26 } else { -0.26 });
+            format!("translate(sphere(0.25), {}, {}, {})", c[0], c[1], c[2])
+        })
+        .collect();
+    let (quad, mc) = quad_and_mc(&format!("union({})", balls.join(", ")), 20);
+    assert_eq!(mc, (16, 8, true));
+    assert_eq!(quad, mc);
+}
+
+/// Issue 15: a thin cavity meshed to nothing. A slot 0.04 thick in a box at res 16 (cells of
+/// 0.125) holds one layer of grid points; MC sees it as a second sphere inside, and so must quad.
+#[test]
+fn a_thin_cavity_is_kept_as_a_second_sphere() {
+    let (quad, mc) = quad_and_mc("subtract(box(0.8, 0.8, 0.8), box(0.6, 0.6, 0.02))", 16);
+    assert_eq!(mc, (4, 2, true));
+    assert_eq!(quad, mc);
+    let (quad, mc) = quad_and_mc("subtract(sphere(0.5), sphere(0.3))", 32);
+    assert_eq!((quad, mc), ((4, 2, true), (4, 2, true)), "the hollow ball");
+}
+
+/// Issue 15: quad ignored `max_cells` (`--res 1000` grew past 3.5 GB). Now it is refused before
+/// anything is sampled, and a cell count that does not fit a u64 cannot wrap past the check.
+#[test]
+fn quad_refuses_grids_past_max_cells_before_allocating() {
+    let err = pipeline::mesh_expr("x", &request(1000)).unwrap_err();
+    assert!(matches!(err, isoforge::Error::GridTooLarge { cells: 1_000_000_000, .. }), "{err}");
+    let huge = Grid::from_points([1 << 22; 3], Vec3::ZERO, Vec3::ONE).unwrap();
+    let err = isoforge::quad::check_size(&huge, u64::MAX).unwrap_err();
+    assert!(matches!(err, isoforge::Error::GridTooLarge { cells: u64::MAX, .. }), "{err}");
 }

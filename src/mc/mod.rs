@@ -448,7 +448,7 @@ fn any_pair_crosses(tris: &[([u32; 3], [DVec3; 3])]) -> bool {
 }
 
 /// Where the surface crosses cell edge `e`, by linear interpolation of the signed values `d`.
-fn edge_point(grid: &Grid, cell: [usize; 3], e: usize, d: &[f32; 8]) -> Vec3 {
+pub(crate) fn edge_point(grid: &Grid, cell: [usize; 3], e: usize, d: &[f32; 8]) -> Vec3 {
     let [a, b] = EDGES[e];
     let (da, db) = (d[a as usize], d[b as usize]);
     let t = (da / (da - db)).clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);

@@ -48,7 +48,10 @@ fn mesh_signed_values(
         Method::Dmc => dmc_on_samples(values, grid, request)?,
         Method::Quad => {
             let field = SampledField { grid: *grid, values, gradient: SampleGradient::Trilinear };
-            let (out, phases) = quad::mesh_field(&field, grid, &request.quad)?;
+            // Signs exactly as MC reads them: the samples minus the iso-level.
+            let shifted: Vec<f32> = values.iter().map(|v| v - request.iso).collect();
+            let level = super::Shifted { field: &field, iso: request.iso };
+            let (out, phases) = quad::mesh_samples(&shifted, &level, grid, &request.quad_options())?;
             Meshed::from_quad(out, phases)
         }
         _ => {

@@ -1,7 +1,10 @@
 //! The one primitive all three collapse operators are built from: merge groups of vertices, drop
-//! the quads that degenerate, and keep the result only if it is still a closed 2-manifold of the
-//! same Euler characteristic with no vertex below valence three. Operators decide *what* to merge
-//! (the paper's rules); this module guarantees that no collapse can break the surface.
+//! the quads that degenerate, and keep the result only if it is still a 2-manifold with the same
+//! Euler characteristic, the same components and the same border, with no vertex below valence
+//! three. Operators decide *what* to merge (the paper's rules); this module guarantees that no
+//! collapse can change the topology. Vertices on the border (pinned to the grid's outer faces)
+//! are never merged, so the border stays where MC's is. Geometry (crossings, folds) is checked per
+//! stage by the caller, since a collapse's effect shows only after re-projection.
 
 use super::mesh::QuadMesh;
 use glam::Vec3;
@@ -16,7 +19,7 @@ pub fn merge(mesh: &QuadMesh, groups: &[(Vec<u32>, Vec3)]) -> Option<QuadMesh> {
     let mut positions = mesh.positions.clone();
     for (group, p) in groups {
         for &v in group {
-            if map.insert(v, group[0]).is_some() {
+            if map.insert(v, group[0]).is_some() || mesh.pin(v) != 0 {
                 return None;
             }
         }
@@ -28,27 +31,23 @@ pub fn merge(mesh: &QuadMesh, groups: &[(Vec<u32>, Vec3)]) -> Option<QuadMesh> {
         .map(|q| q.map(|v| map.get(&v).copied().unwrap_or(v)))
         .filter(|q| (0..4).all(|i| (i + 1..4).all(|j| q[i] != q[j])))
         .collect();
-    let out = QuadMesh { positions, quads };
+    let out = QuadMesh { positions, quads, pins: mesh.pins.clone() };
+    let val = out.valences();
     let valid = out.euler() == mesh.euler()
-        && out.valences().iter().all(|&v| v == 0 || v >= 3)
-        && out.is_closed_manifold();
+        && (0..val.len()).all(|v| val[v] == 0 || val[v] >= 3 || out.pin(v as u32) != 0)
+        && out.is_manifold()
+        && out.boundary_edges() == mesh.boundary_edges()
+        && out.components() == mesh.components();
     valid.then_some(out)
 }
 
-/// The neighbours of `v` in turning order around it (a closed fan on a closed manifold).
-pub fn ordered_neighbours(mesh: &QuadMesh, edges: &HashMap<(u32, u32), (u32, u8)>, v: u32) -> Vec<u32> {
-    match edges.iter().find(|(k, _)| k.0 == v) {
-        Some((_, &corner)) => ordered_neighbours_from(mesh, edges, corner),
-        None => Vec::new(),
-    }
-}
-
-/// Like [`ordered_neighbours`] but starting from a known corner, avoiding the scan for one.
+/// The neighbours of the vertex at corner `(f0, c0)` in turning order around it, starting from
+/// that corner. `None` when its fan is open (a border vertex): the operators leave those alone.
 pub fn ordered_neighbours_from(
     mesh: &QuadMesh,
     edges: &HashMap<(u32, u32), (u32, u8)>,
     (f0, c0): (u32, u8),
-) -> Vec<u32> {
+) -> Option<Vec<u32>> {
     let v = mesh.quads[f0 as usize][c0 as usize];
     let mut out = Vec::new();
     let (mut f, mut c) = (f0, c0);
@@ -56,9 +55,9 @@ pub fn ordered_neighbours_from(
         let q = mesh.quads[f as usize];
         out.push(q[(c as usize + 1) % 4]);
         let prev = q[(c as usize + 3) % 4];
-        (f, c) = edges[&(v, prev)];
+        (f, c) = *edges.get(&(v, prev))?;
         if f == f0 || out.len() > 64 {
-            return out;
+            return Some(out);
         }
     }
 }

@@ -11,9 +11,23 @@ use std::collections::HashMap;
 pub struct QuadMesh {
     pub positions: Vec<Vec3>,
     pub quads: Vec<[u32; 4]>,
+    /// Per vertex, bit `a` set when the vertex lies on the grid's outer face normal to axis `a` and
+    /// must stay there (the border of a surface cut open by the bounds, as MC cuts it). Empty means
+    /// no vertex is pinned. Pinned vertices are exactly the mesh's boundary vertices.
+    pub pins: Vec<u8>,
 }
 
 impl QuadMesh {
+    /// A mesh without pinned vertices.
+    pub fn new(positions: Vec<Vec3>, quads: Vec<[u32; 4]>) -> QuadMesh {
+        QuadMesh { positions, quads, pins: Vec::new() }
+    }
+
+    /// The pinned axes of vertex `v` (see [`QuadMesh::pins`]).
+    pub fn pin(&self, v: u32) -> u8 {
+        self.pins.get(v as usize).copied().unwrap_or(0)
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
@@ -79,16 +93,46 @@ impl QuadMesh {
     pub fn compact(&mut self) {
         let mut map = vec![u32::MAX; self.positions.len()];
         let mut positions = Vec::new();
+        let mut pins = Vec::new();
         for q in &mut self.quads {
             for v in q.iter_mut() {
                 if map[*v as usize] == u32::MAX {
                     map[*v as usize] = positions.len() as u32;
                     positions.push(self.positions[*v as usize]);
+                    pins.push(self.pins.get(*v as usize).copied().unwrap_or(0));
                 }
                 *v = map[*v as usize];
             }
         }
         self.positions = positions;
+        self.pins = if self.pins.is_empty() { Vec::new() } else { pins };
+    }
+
+    /// Components connected through shared vertices, as the triangle analysis counts them.
+    pub fn components(&self) -> usize {
+        let mut parent: Vec<u32> = (0..self.positions.len() as u32).collect();
+        fn root(parent: &mut [u32], mut v: u32) -> u32 {
+            while parent[v as usize] != v {
+                parent[v as usize] = parent[parent[v as usize] as usize];
+                v = parent[v as usize];
+            }
+            v
+        }
+        for q in &self.quads {
+            for &v in &q[1..] {
+                let (a, b) = (root(&mut parent, q[0]), root(&mut parent, v));
+                parent[a as usize] = b;
+            }
+        }
+        let val = self.valences();
+        (0..self.positions.len() as u32).filter(|&v| val[v as usize] > 0 && root(&mut parent, v) == v).count()
+    }
+
+    /// Edges used by one quad only: the border where the bounds cut the surface open.
+    pub fn boundary_edges(&self) -> usize {
+        let directed: std::collections::HashSet<(u32, u32)> =
+            self.quads.iter().flat_map(|q| (0..4).map(move |i| (q[i], q[(i + 1) % 4]))).collect();
+        directed.iter().filter(|&&(a, b)| !directed.contains(&(b, a))).count()
     }
 
     /// Euler characteristic V − E + F over used vertices (each undirected edge counted once).
@@ -108,9 +152,19 @@ impl QuadMesh {
     /// reverse also present (closed, consistently oriented, two quads per edge), and the quads
     /// around every vertex form a single fan (a disk, not two cones touching at a point).
     pub fn is_closed_manifold(&self) -> bool {
+        self.is_manifold() && self.boundary_edges() == 0
+    }
+
+    /// Like [`QuadMesh::is_closed_manifold`] but a directed edge may lack its reverse (a border):
+    /// every directed edge occurs once, and the quads around every vertex form one fan, closed or
+    /// open (a disk or a half-disk).
+    pub fn is_manifold(&self) -> bool {
         let mut map: HashMap<(u32, u32), (u32, u8)> = HashMap::with_capacity(self.quads.len() * 4);
         for (f, q) in self.quads.iter().enumerate() {
             for i in 0..4 {
+                if q[i] as usize >= self.positions.len() {
+                    return false;
+                }
                 for j in i + 1..4 {
                     if q[i] == q[j] {
                         return false;
@@ -121,29 +175,35 @@ impl QuadMesh {
                 }
             }
         }
-        if map.keys().any(|&(a, b)| !map.contains_key(&(b, a))) {
-            return false;
-        }
-        // Walk the fan of each vertex from one corner; it must reach every corner at that vertex.
         let val = self.valences();
         let mut seen = vec![false; self.positions.len()];
-        for q in &self.quads {
-            for i in 0..4 {
-                let v = q[i];
-                if seen[v as usize] {
+        for (f, q) in self.quads.iter().enumerate() {
+            for (i, &v) in q.iter().enumerate() {
+                if std::mem::replace(&mut seen[v as usize], true) {
                     continue;
                 }
-                seen[v as usize] = true;
-                let mut steps = 0u32;
-                let mut corner = (q, i);
+                // Turn clockwise to the start of an open fan (or once round a closed one) ...
+                let (mut g, mut j) = (f as u32, i as u8);
+                for _ in 0..val[v as usize] {
+                    let quad = &self.quads[g as usize];
+                    let next = quad[(j as usize + 1) % 4];
+                    match map.get(&(next, v)) {
+                        Some(&(h, k)) if (h, (k + 1) % 4) != (f as u32, i as u8) => (g, j) = (h, (k + 1) % 4),
+                        _ => break,
+                    }
+                }
+                // ... then count the corners counter-clockwise; one fan must hold them all.
+                let start = (g, j);
+                let mut steps = 1u32;
                 loop {
-                    // The edge entering v in this quad, reversed, leaves v in the next quad.
-                    let prev = corner.0[(corner.1 + 3) % 4];
-                    let (g, j) = map[&(v, prev)];
-                    steps += 1;
-                    corner = (&self.quads[g as usize], j as usize);
-                    if std::ptr::eq(corner.0, q) || steps > val[v as usize] {
-                        break;
+                    let quad = &self.quads[g as usize];
+                    let prev = quad[(j as usize + 3) % 4];
+                    match map.get(&(v, prev)) {
+                        Some(&c) if c != start && steps <= val[v as usize] => {
+                            (g, j) = c;
+                            steps += 1;
+                        }
+                        _ => break,
                     }
                 }
                 if steps != val[v as usize] {
@@ -199,7 +259,7 @@ pub(crate) mod tests {
         let positions =
             (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)).collect();
         let quads = vec![[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        QuadMesh { positions, quads }
+        QuadMesh::new(positions, quads)
     }
 
     #[test]
@@ -220,5 +280,17 @@ pub(crate) mod tests {
         let mut c = cube();
         c.quads[0].reverse();
         assert!(!c.is_closed_manifold());
+        // An open box is a manifold with a border; two boxes sharing one corner are not manifold.
+        let mut open = cube();
+        open.quads.pop();
+        assert!(open.is_manifold() && open.boundary_edges() == 4 && open.euler() == 1);
+        let mut two = cube();
+        let moved: Vec<Vec3> = two.positions.iter().map(|p| *p + Vec3::splat(1.0)).collect();
+        two.positions.extend(moved);
+        let copy: Vec<[u32; 4]> =
+            two.quads.iter().map(|q| q.map(|v| if v == 0 { 7 } else { v + 8 })).collect();
+        two.quads.extend(copy);
+        assert!(!two.is_manifold(), "two cubes touching at a corner");
+        assert_eq!(cube().components(), 1);
     }
 }

@@ -65,7 +65,8 @@ fn trace(
         rungs.push((q[(c_us + 1) % 4], q[c_us]));
         // Leave through the opposite edge into the neighbour holding it reversed.
         let (a, b) = (q[(c_us + 2) % 4], q[(c_us + 3) % 4]);
-        let (g, j) = edges[&(b, a)];
+        // A strip that runs into the border is not a ring.
+        let &(g, j) = edges.get(&(b, a))?;
         (f, c) = (g, j);
         if f == f0 && c % 2 == dir % 2 || rungs.len() > mesh.quads.len() {
             break;

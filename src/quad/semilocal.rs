@@ -74,16 +74,16 @@ fn walk(
 ) -> Option<(usize, [u32; 4], usize)> {
     let q = mesh.quads[f];
     let s = q[c];
-    let around = ordered_neighbours_from(mesh, edges, (f as u32, c as u8));
+    let around = ordered_neighbours_from(mesh, edges, (f as u32, c as u8))?;
     // Around a valence-three vertex the fan from corner c lists q[c+1], the outside edge, q[c+3].
     let mut prev = s;
     let mut cur = *around.iter().find(|&&u| u != q[(c + 1) % 4] && u != q[(c + 3) % 4])?;
     for _ in 0..mesh.quads.len() {
         match val[cur as usize] {
             4 => {
-                let (g, j) = edges[&(cur, prev)];
-                let ring = ordered_neighbours_from(mesh, edges, (g, j));
-                let next = ring[2];
+                let &(g, j) = edges.get(&(cur, prev))?;
+                let ring = ordered_neighbours_from(mesh, edges, (g, j))?;
+                let next = *ring.get(2)?;
                 prev = cur;
                 cur = next;
                 if cur == s {
@@ -92,10 +92,10 @@ fn walk(
             }
             3 => {
                 // The quad at `cur` containing neither edge of the line: the one not holding `prev`.
-                let (g, j) = edges[&(cur, prev)];
-                let ring = ordered_neighbours_from(mesh, edges, (g, j));
+                let &(g, j) = edges.get(&(cur, prev))?;
+                let ring = ordered_neighbours_from(mesh, edges, (g, j))?;
                 // ring = [prev, a, b]: the quad between a and b is the third one.
-                let (f2, c2) = edges[&(cur, ring[1])];
+                let &(f2, c2) = edges.get(&(cur, *ring.get(1)?))?;
                 let q2 = mesh.quads[f2 as usize];
                 let c2 = c2 as usize;
                 if f2 as usize != f && is_3m3n(&q2, val, c2 % 2) {

@@ -151,6 +151,8 @@ export interface MeshStats {
     stage: string; vertices: number; quads: number; euler: number; valence4_share: number;
     irregular: number; operations: number; aspect_mean: number; aspect_max: number;
     dist_max: number; dist_rms: number;
+    /** Vertices left where the stage found them (1 for a stage undone whole) so nothing crosses. */
+    held_back: number;
   }[];
 }
 
