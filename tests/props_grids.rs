@@ -317,6 +317,26 @@ fn prop_mc_trilinear_is_a_closed_manifold() {
     });
 }
 
+/// DMC over the samples' trilinear interpolant: always closed (the octree's field is clipped to
+/// the grid's box), outward, crossing- and fold-free. Its topology is not promised (see the
+/// README's guarantees), so it is not compared with MC's.
+#[test]
+fn prop_dmc_on_samples_is_closed_and_crossing_free() {
+    for_cases(7_000_000, 12, |seed, case| {
+        let mesh = mesh(case, Method::Dmc, Topology::Fixed);
+        let what = format!("seed {seed} dmc: {}", case.describe());
+        assert!(mesh.positions.iter().all(|p| p.is_finite()), "{what}: non-finite vertex");
+        let topo = analysis::topology(&mesh);
+        assert!(topo.is_closed_manifold(), "{what}: {topo:?}");
+        assert_eq!(topo.degenerate_triangles, 0, "{what}: degenerate triangles");
+        if mesh.triangle_count() > 0 {
+            assert!(analysis::signed_volume(&mesh) > 0.0, "{what}: not outward");
+        }
+        assert_eq!(analysis::self_intersections(&mesh), 0, "{what}: self-intersections");
+        assert_eq!(analysis::folded_pairs(&mesh), Vec::<[u32; 2]>::new(), "{what}: folds");
+    });
+}
+
 /// EMC's promises apart from self-intersections (see [`prop_emc_does_not_cross_itself`]): an
 /// oriented manifold, closed on padded grids and open only on the bounds on unpadded ones, MC's
 /// Euler characteristic (fixed table), and every vertex in a crossed cell or at most half a cell

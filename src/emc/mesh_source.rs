@@ -31,6 +31,15 @@ use crate::mesh::Mesh;
 use glam::{DVec2, Vec3};
 use web_time::Instant;
 
+/// A triangle's corners as bits, turned so the smallest comes first: the same key for the same
+/// triangle listed from any of its corners, a different one when it is wound the other way (a
+/// triangle and its reverse are two sheets that cancel, not a repeat).
+fn cyclic_key(corners: [Vec3; 3]) -> [[u32; 3]; 3] {
+    let bits = corners.map(|p| p.to_array().map(f32::to_bits));
+    let first = (0..3).min_by_key(|&i| bits[i]).unwrap_or(0);
+    [bits[first], bits[(first + 1) % 3], bits[(first + 2) % 3]]
+}
+
 /// A triangle mesh prepared for ray and distance queries.
 pub struct MeshBvh {
     triangles: Vec<[Vec3; 3]>,
@@ -40,13 +49,17 @@ pub struct MeshBvh {
     bvh: Bvh,
     /// How many triangles of the input were left out for having no area.
     pub degenerate: usize,
+    /// How many were left out for repeating an earlier triangle (the same corners, wound the same
+    /// way): an exporter's duplicate would count twice in every winding number through it and
+    /// turn its side of the surface inside out.
+    pub duplicates: usize,
     /// Whether the input was inside out (negative enclosed volume) and was turned around.
     pub flipped: bool,
 }
 
 impl MeshBvh {
     /// Indexes the triangles of `mesh`. Triangles without area are left out (no ray can hit them
-    /// and they have no normal); a mesh whose triangles enclose a negative volume is taken to be
+    /// and they have no normal), and so are repeats of a triangle already listed; a mesh whose triangles enclose a negative volume is taken to be
     /// inside out and turned around, so normals point out of the solid either way.
     pub fn new(mesh: &Mesh) -> Result<MeshBvh, Error> {
         let n = mesh.positions.len();
@@ -61,14 +74,22 @@ impl MeshBvh {
         }
         let mut triangles = Vec::with_capacity(mesh.triangles.len());
         let mut volume = 0.0f64;
+        let mut seen = std::collections::HashSet::with_capacity(mesh.triangles.len());
+        let mut degenerate = 0;
+        let mut duplicates = 0;
         for t in 0..mesh.triangles.len() {
             let [a, b, c] = mesh.corners(t);
-            if (b - a).cross(c - a).length_squared() > 0.0 {
-                triangles.push([a, b, c]);
-                volume += a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3()));
+            if (b - a).cross(c - a).length_squared() <= 0.0 {
+                degenerate += 1;
+                continue;
             }
+            if !seen.insert(cyclic_key([a, b, c])) {
+                duplicates += 1;
+                continue;
+            }
+            triangles.push([a, b, c]);
+            volume += a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3()));
         }
-        let degenerate = mesh.triangles.len() - triangles.len();
         if triangles.is_empty() {
             return Err(Error::InvalidOption(format!(
                 "the mesh has no triangles with area ({} degenerate ones) and encloses nothing",
@@ -85,7 +106,7 @@ impl MeshBvh {
             triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bvh = Bvh::build(&boxes);
-        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, flipped })
+        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped })
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -327,7 +327,8 @@ fn extract(
                     let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
-                        let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max };
+                        let domain = (grid.origin, grid.max());
+                        let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max, domain };
                         let near = component.grown(placement::GROWTH);
                         let (mut kind, mut solved) = feature::sharp_point(&pts, &nrm, kind, near);
                         if options.resample_creases {

@@ -41,19 +41,25 @@ const LATTICE_SAMPLES: usize = 8;
 const TOWARD_STEPS: usize = 10;
 
 /// The surface component a feature point is placed for: its MC polygon and the field normals at
-/// the polygon's vertices, and the cell it lies in.
+/// the polygon's vertices, the cell it lies in, and the grid's box, which no centre may leave
+/// (a cell on the grid's border grows only inward: the mesh stays in the bounds).
 pub struct Component<'a> {
     pub pts: &'a [Vec3],
     pub nrm: &'a [Vec3],
     pub cell_min: Vec3,
     pub cell_max: Vec3,
+    pub domain: (Vec3, Vec3),
 }
 
+/// A domain that limits nothing, for components placed on their own.
+pub const UNBOUNDED: (Vec3, Vec3) = (Vec3::NEG_INFINITY, Vec3::INFINITY);
+
 impl Component<'_> {
-    /// The component's cell grown by `growth` cells on every side (shrunk where negative).
+    /// The component's cell grown by `growth` cells on every side (shrunk where negative), within
+    /// the grid's box.
     pub fn grown(&self, growth: f32) -> (Vec3, Vec3) {
         let margin = (self.cell_max - self.cell_min) * growth;
-        (self.cell_min - margin, self.cell_max + margin)
+        ((self.cell_min - margin).max(self.domain.0), (self.cell_max + margin).min(self.domain.1))
     }
 }
 
@@ -249,7 +255,8 @@ mod tests {
         let nrm = [a, a, b];
         let solved = Vec3::new(0.377, 0.136, 0.824);
         assert!(!fan_is_valid(solved, &pts, &nrm), "the exact point folds: the case this module is for");
-        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        let component =
+            Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE, domain: UNBOUNDED };
         let placed = place(solved, FeatureKind::Edge, &component).expect("a valid fan").at;
         assert!(!placed.on_feature, "no point of the crease gives a valid fan here");
         let p = placed.position;
@@ -295,6 +302,7 @@ mod tests {
             nrm: &nrm,
             cell_min: Vec3::new(28.0, 35.0, 42.0),
             cell_max: Vec3::new(29.0, 36.0, 43.0),
+            domain: UNBOUNDED,
         };
         let placed = place(solved, FeatureKind::Edge, &cell).expect("a valid fan").at;
         assert!(!placed.on_feature);
@@ -319,7 +327,8 @@ mod tests {
     fn an_edge_point_outside_the_cell_is_slid_along_its_line_into_it() {
         // Planes x = 0.5 (normal +x) and y = 0.5 (normal +y): the crease is the line x = y = 0.5.
         let (pts, nrm) = crease_x_y_half();
-        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        let component =
+            Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE, domain: UNBOUNDED };
         // The fan is valid for 0.2 < z < 0.8 only: the nearest valid point of the crease is taken.
         let placed = place(Vec3::new(0.5, 0.5, 1.4), FeatureKind::Edge, &component).unwrap().at;
         let p = placed.position;
@@ -333,7 +342,8 @@ mod tests {
         // The crease x = y = 0.5 of the test above, cut off at z = 0.7 by a third face the
         // component does not see: its nearest valid point (z near 0.78) lies past the crease's end.
         let (pts, nrm) = crease_x_y_half();
-        let component = Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE };
+        let component =
+            Component { pts: &pts, nrm: &nrm, cell_min: Vec3::ZERO, cell_max: Vec3::ONE, domain: UNBOUNDED };
         let solved = Vec3::new(0.5, 0.5, 1.4);
         let mut placed = place(solved, FeatureKind::Edge, &component).unwrap();
         let third_face = |p: Vec3| Some((p.z - 0.7).abs());

@@ -1,0 +1,246 @@
+//! Seeded random CSG trees (2–12 primitives of every kind, random transforms, every combinator
+//! with smooth blends and shells, thin parts, parts reaching past the bounds), typed as programs
+//! and meshed by every method over [-1, 1]³, checked against what the README's "Guarantees"
+//! table promises for each method.
+//!
+//! A failing case prints its seed and its program; `ISOFORGE_SEED=S cargo test --test props_csg`
+//! reruns that one, `ISOFORGE_SOAK=N` runs N trees per property (see `common::case_seeds`). The
+//! quad method has its own suite (`props_quad.rs`), which takes these trees too.
+
+mod common;
+
+use common::csg::{random_tree, Tree};
+use common::{case_seeds, Rng};
+use isoforge::expr::{self, Program};
+use isoforge::mc::Topology;
+use isoforge::mesh::analysis;
+use isoforge::pipeline::{self, Method, Output, Request};
+use isoforge::stats::AnalysisOptions;
+use isoforge::{Field, Mesh};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
+
+const CI_TREES: usize = 24;
+
+/// One generated input: the tree, its compiled program and the resolution it is meshed at.
+struct Case {
+    seed: u64,
+    tree: Tree,
+    program: Program,
+    res: usize,
+}
+
+impl Case {
+    fn new(seed: u64) -> Case {
+        let mut rng = Rng::new(seed);
+        let tree = random_tree(&mut rng);
+        let program = expr::compile(&tree.text)
+            .unwrap_or_else(|e| panic!("seed {seed}: the generator wrote a bad program: {e}\n{}", tree.text));
+        let res = 16 + rng.below(17) as usize;
+        Case { seed, tree, program, res }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "seed {}, res {}, {} primitives: {}",
+            self.seed, self.res, self.tree.primitives, self.tree.text
+        )
+    }
+
+    /// The cell side of the grid over the default bounds.
+    fn cell(&self) -> f32 {
+        2.0 / self.res as f32
+    }
+
+    fn mesh(&self, method: Method, topology: Topology) -> Output {
+        let request = Request {
+            method,
+            topology,
+            res: self.res,
+            analysis: AnalysisOptions { self_intersections: false, surface_error: false },
+            ..Request::default()
+        };
+        pipeline::mesh_program(&self.program, &request)
+            .unwrap_or_else(|e| panic!("{method:?} failed: {e}\n{}", self.describe()))
+    }
+}
+
+fn for_trees(seed_base: u64, mut check: impl FnMut(&Case)) {
+    for seed in case_seeds(seed_base, CI_TREES) {
+        check(&Case::new(seed));
+    }
+}
+
+/// What every method promises of any output: finite coordinates, no degenerate triangles, a
+/// consistently oriented manifold, open only on the faces of the bounds; closed and outward where
+/// `closed` (plain MC's output is closed: the surface stays inside the bounds); no pair of
+/// triangles crossing when `crossings`, none folded onto its neighbour across an edge when `folds`.
+/// Folds are legitimate MC output where a wall is thinner than a cell (its two sheets meet at a
+/// knife edge), so only the methods that promise more are asked for them.
+fn check_sound(
+    mesh: &Mesh,
+    closed: bool,
+    crossings: bool,
+    folds: bool,
+) -> Result<analysis::Topology, String> {
+    if let Some(p) = mesh.positions.iter().find(|p| !p.is_finite()) {
+        return Err(format!("non-finite vertex {p}"));
+    }
+    let topo = analysis::topology(mesh);
+    if topo.degenerate_triangles > 0 {
+        return Err(format!("{} degenerate triangles", topo.degenerate_triangles));
+    }
+    if (topo.non_manifold_edges, topo.non_manifold_vertices, topo.misoriented_edges) != (0, 0, 0) {
+        return Err(format!("not an oriented manifold: {topo:?}"));
+    }
+    if closed {
+        if topo.boundary_edges > 0 {
+            return Err(format!("open: {} border edges", topo.boundary_edges));
+        }
+        if mesh.triangle_count() > 0 && analysis::signed_volume(mesh) <= 0.0 {
+            return Err("not oriented outward".into());
+        }
+    } else if let Some(p) = border_vertex_inside(mesh) {
+        return Err(format!("a border edge ends at {p}, inside the bounds"));
+    }
+    if crossings {
+        let crossing = analysis::self_intersecting_pairs(mesh);
+        if let Some(first) = crossing.first() {
+            return Err(format!("{} crossing pairs, first {first:?}", crossing.len()));
+        }
+    }
+    if folds {
+        let folded = analysis::folded_pairs(mesh);
+        if let Some(first) = folded.first() {
+            return Err(format!("{} folded pairs, first {first:?}", folded.len()));
+        }
+    }
+    Ok(topo)
+}
+
+/// A vertex of a border edge that does not lie on a face of the bounds [-1, 1]³ (grids over
+/// them reach a little past them to whole cells, so "on a face" means beyond 0.999).
+fn border_vertex_inside(mesh: &Mesh) -> Option<isoforge::Vec3> {
+    let mut count = std::collections::HashMap::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    count
+        .into_iter()
+        .filter(|&(_, n)| n == 1)
+        .flat_map(|((a, b), _)| [a, b])
+        .map(|v| mesh.positions[v as usize])
+        .find(|p| p.abs().max_element() < 0.999)
+}
+
+/// Every vertex within `cells` cells of the surface, checked through the field's Lipschitz bound:
+/// a vertex at distance d from the surface has |f| ≤ L·d, so |f| > L·cells·h proves it farther.
+fn check_near(case: &Case, mesh: &Mesh, cells: f32) -> Result<(), String> {
+    let bound = case.tree.lipschitz * cells * case.cell();
+    match mesh.positions.iter().map(|&p| (p, case.program.value(p))).find(|(_, v)| v.abs() > bound) {
+        Some((p, v)) => Err(format!("vertex {p} has |f| = {} > {bound} ({cells} cells)", v.abs())),
+        None => Ok(()),
+    }
+}
+
+/// Which of the stronger promises a method makes (see `check_sound`).
+#[derive(Clone, Copy)]
+struct Promises {
+    crossings: bool,
+    folds: bool,
+}
+
+fn sound(case: &Case, what: &str, mesh: &Mesh, closed: bool, promises: Promises) -> analysis::Topology {
+    check_sound(mesh, closed, promises.crossings, promises.folds)
+        .unwrap_or_else(|e| panic!("{what}: {e}\n{}", case.describe()))
+}
+
+const CROSSING_FREE: Promises = Promises { crossings: true, folds: false };
+const CROSSING_AND_FOLD_FREE: Promises = Promises { crossings: true, folds: true };
+const MANIFOLD_ONLY: Promises = Promises { crossings: false, folds: false };
+
+fn near(case: &Case, what: &str, mesh: &Mesh, cells: f32) {
+    check_near(case, mesh, cells).unwrap_or_else(|e| panic!("{what}: {e}\n{}", case.describe()));
+}
+
+fn mc_closed(mc: &Output) -> bool {
+    mc.stats.boundary_edges == 0
+}
+
+/// Plain MC, both topologies: sound, crossing-free, every vertex on a crossed grid edge and so
+/// within one cell of the surface.
+#[test]
+fn prop_mc_is_sound_and_near_the_surface() {
+    for_trees(1_500_000, |case| {
+        for topology in [Topology::Fixed, Topology::Trilinear] {
+            let what = format!("mc {topology:?}");
+            let mc = case.mesh(Method::Mc, topology);
+            sound(case, &what, &mc.mesh, mc_closed(&mc), CROSSING_FREE);
+            near(case, &what, &mc.mesh, 1.0);
+        }
+    });
+}
+
+/// EMC: sound, MC's Euler characteristic and components on the same grid, every vertex (edge
+/// crossings and feature points, which stay in their cell) within a cell diagonal.
+#[test]
+fn prop_emc_keeps_mcs_topology_near_the_surface() {
+    for_trees(2_500_000, |case| {
+        let mc = case.mesh(Method::Mc, Topology::Fixed);
+        let emc = case.mesh(Method::Emc, Topology::Fixed);
+        let topo = sound(case, "emc", &emc.mesh, mc_closed(&mc), MANIFOLD_ONLY);
+        assert_eq!(
+            (topo.euler, topo.components),
+            (mc.stats.euler, mc.stats.components),
+            "emc vs mc topology\n{}",
+            case.describe()
+        );
+        near(case, "emc", &emc.mesh, 3f32.sqrt());
+    });
+}
+
+/// MCQ: sound and crossing-free (its uncross pass), MC's topology, inner vertices in their cells.
+#[test]
+fn prop_mcq_keeps_mcs_topology_without_crossings() {
+    for_trees(3_500_000, |case| {
+        let mc = case.mesh(Method::Mc, Topology::Fixed);
+        let mcq = case.mesh(Method::Mcq, Topology::Fixed);
+        let topo = sound(case, "mcq", &mcq.mesh, mc_closed(&mc), CROSSING_FREE);
+        assert_eq!(
+            (topo.euler, topo.components),
+            (mc.stats.euler, mc.stats.components),
+            "mcq vs mc topology\n{}",
+            case.describe()
+        );
+        near(case, "mcq", &mcq.mesh, 3f32.sqrt());
+    });
+}
+
+/// DMC: always closed (the shape is clipped to the bounds), outward, crossing- and fold-free.
+/// Its topology is not promised (see the README: the top-down octree can miss parts its samples
+/// do not see), so it is not compared with MC's here.
+#[test]
+fn prop_dmc_is_closed_and_crossing_free() {
+    for_trees(4_500_000, |case| {
+        let dmc = case.mesh(Method::Dmc, Topology::Fixed);
+        sound(case, "dmc", &dmc.mesh, true, CROSSING_AND_FOLD_FREE);
+    });
+}
+
+/// EMC crossing-free on random trees: not yet kept (fans of two components in one cell, and
+/// flipped edges between fan centres, can cross; see the README's guarantees table).
+#[test]
+#[ignore = "EMC still self-intersects on some random CSG trees (issue 15)"]
+fn prop_emc_does_not_cross_itself() {
+    for_trees(2_500_000, |case| {
+        let mc = case.mesh(Method::Mc, Topology::Fixed);
+        let emc = case.mesh(Method::Emc, Topology::Fixed);
+        sound(case, "emc", &emc.mesh, mc_closed(&mc), CROSSING_FREE);
+    });
+}
