@@ -103,9 +103,6 @@ impl Grid {
                 self.cells[0], self.cells[1], self.cells[2]
             )));
         }
-        if self.points().iter().try_fold(1usize, |n, &p| n.checked_mul(p)).is_none() {
-            return Err(Error::GridTooLarge { cells: self.cell_count(), max_cells: usize::MAX as u64 });
-        }
         let far = self.max();
         let reach = far.abs().max(self.origin.abs()).max_element();
         if reach.is_nan() || reach > MAX_COORDINATE {
@@ -176,11 +173,22 @@ impl Grid {
         self.spacing.max_element()
     }
 
-    /// Fails with [`Error::GridTooLarge`] when the grid exceeds `max_cells`.
+    /// Fails with [`Error::GridTooLarge`] when the grid exceeds `max_cells`. Every method calls it
+    /// before it allocates the grid's samples.
     pub fn check_size(&self, max_cells: u64) -> Result<(), Error> {
         let cells = self.cell_count();
-        if cells > max_cells {
+        // A saturated count stands for one past every limit.
+        if cells > max_cells || cells == u64::MAX {
             return Err(Error::GridTooLarge { cells, max_cells });
+        }
+        // On wasm32 a raised maxCells can still ask for more samples than an address space holds.
+        if self.points().iter().try_fold(1usize, |n, &p| n.checked_mul(p)).is_none() {
+            return Err(Error::InvalidGrid(format!(
+                "{} x {} x {} points do not fit in this platform's memory",
+                self.cells[0] + 1,
+                self.cells[1] + 1,
+                self.cells[2] + 1
+            )));
         }
         Ok(())
     }

@@ -55,7 +55,7 @@ fn a_resolution_whose_cell_count_would_wrap_is_refused() {
     }
     let widest = Grid { origin: Vec3::ZERO, spacing: Vec3::ONE, cells: [1 << 21; 3] };
     assert_eq!(widest.cell_count(), 1 << 63, "counts are exact up to the per-axis limit");
-    let past = Grid { cells: [usize::MAX, 2, 2], ..widest };
+    let past = Grid { cells: [u32::MAX as usize; 3], ..widest };
     assert_eq!(past.cell_count(), u64::MAX, "and saturate, never wrap, past it");
     error_of(Grid::new(Vec3::ZERO, Vec3::ONE, [(1 << 21) + 1, 1, 1]), "at most 2097152 cells");
     // f32 places vertices in a cell only with enough representable positions: with the origin
@@ -76,6 +76,25 @@ fn every_grid_method_honours_max_cells() {
 fn dmc_work_is_capped_like_max_cells() {
     let r = Request { tolerance: 0.0, max_depth: Some(12), ..request(Method::Dmc, 64) };
     error_of(pipeline::mesh_expr("sphere(0.5)", &r), "more work than maxCells allows");
+}
+
+/// A 2 x 2 x 250 volume of noise at tolerance 0: DMC's cubic octree over it ran for minutes and
+/// grew without bound. Now its work is bounded by maxCells (in samples), and it finishes.
+#[test]
+fn dmc_on_a_long_thin_noise_volume_is_bounded() {
+    let grid = Grid::from_points([2, 2, 250], Vec3::ZERO, Vec3::ONE).unwrap();
+    let mut rng = common::Rng::new(250);
+    let values: Vec<f32> = (0..grid.point_count()).map(|_| rng.range(-1.0, 1.0)).collect();
+    let r = Request { tolerance: 0.0, ..request(Method::Dmc, 8) };
+    match pipeline::mesh_samples(&values, &grid, &r) {
+        Ok(out) => {
+            let leaves = out.stats.octree_leaves.unwrap_or(0) as u64;
+            let samples = (r.samples_per_cell as u64).pow(3);
+            assert!(leaves * samples <= r.max_cells + 8 * samples, "{leaves} leaves past the cap");
+            common::assert_watertight(&out.mesh, "dmc noise column");
+        }
+        Err(e) => assert!(e.to_string().contains("maxCells"), "{e}"),
+    }
 }
 
 #[test]

@@ -96,13 +96,7 @@ pub struct QuadResult {
 /// Refuses a grid of more than `max_cells` cells (or whose cell or point count does not fit a
 /// `u64`), with checked arithmetic so that no product can wrap past the check.
 pub fn check_size(grid: &Grid, max_cells: u64) -> Result<(), Error> {
-    let [a, b, c] = grid.cells.map(|n| n as u64);
-    let cells = a.checked_mul(b).and_then(|ab| ab.checked_mul(c));
-    let points = grid.points().iter().try_fold(1u64, |acc, &n| acc.checked_mul(n as u64));
-    match (cells, points) {
-        (Some(cells), Some(_)) if cells <= max_cells => Ok(()),
-        (cells, _) => Err(Error::GridTooLarge { cells: cells.unwrap_or(u64::MAX), max_cells }),
-    }
+    grid.check_size(max_cells)
 }
 
 /// Runs the whole method on `field` (inside where it is negative) sampled on `grid`.
