@@ -107,7 +107,8 @@ impl Grid {
             return Err(Error::GridTooLarge { cells: self.cell_count(), max_cells: usize::MAX as u64 });
         }
         let far = self.max();
-        if !(far.abs().max(self.origin.abs()).max_element() <= MAX_COORDINATE) {
+        let reach = far.abs().max(self.origin.abs()).max_element();
+        if reach.is_nan() || reach > MAX_COORDINATE {
             return Err(Error::InvalidGrid(format!(
                 "the grid from {} spaced by {} reaches {far}; coordinates must lie within ±{MAX_COORDINATE:e} \
                  so that areas, volumes and normals stay finite in f32",
