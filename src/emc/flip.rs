@@ -1,6 +1,14 @@
 //! The edge-flipping pass of EMC (§4.3): after the fans are in, flip every edge whose two opposite
 //! vertices are feature points, so feature lines become explicit chains of mesh edges.
+//!
+//! A flip is a decision about a mesh that does not cross itself, and must keep it so: its two new
+//! triangles reach from one fan centre across a cell face to the next, over triangles of both
+//! cells and (where a centre sits outside its cell, or a neighbour's fan reaches in) of cells
+//! around them, none of which the fans' own construction knew of. So a flip is made only when
+//! neither new triangle crosses any triangle near it as the mesh stands (see
+//! [`super::nearby`]); each accepted flip then leaves every pair it did not touch as it was.
 
+use super::nearby::TriangleBuckets;
 use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -13,8 +21,15 @@ use std::collections::HashMap;
 /// A flip is also refused when the new edge
 /// already exists (it would make the mesh non-manifold), when a new triangle would be degenerate, or
 /// when a new triangle would face against the vertex normal (`mesh.normals`, from the field) of its
-/// non-feature vertex (a fold-over).
-pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool], on_feature: &[bool]) -> usize {
+/// non-feature vertex (a fold-over), and when a new triangle would cross a triangle near it
+/// (`spacing`: the grid's cell, the size of the neighbourhoods searched). Edges are visited in
+/// the order of their vertex ids, so the same mesh always gets the same flips.
+pub fn flip_toward_features(
+    mesh: &mut Mesh,
+    is_feature: &[bool],
+    on_feature: &[bool],
+    spacing: Vec3,
+) -> usize {
     // Directed edge (from, to) → the triangle that has it. Closed manifold meshes have each edge
     // once in each direction.
     // Only triangles at a feature point can take part in a flip (both triangles of a flipped edge
@@ -28,7 +43,9 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool], on_feature: &[
             directed.insert((tri[k], tri[(k + 1) % 3]), t as u32);
         }
     }
-    let candidates: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
+    let mut candidates: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
+    candidates.sort_unstable();
+    let mut buckets = TriangleBuckets::new(mesh, spacing);
     let mut flips = 0;
     for (a, b) in candidates {
         let (Some(&t1), Some(&t2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
@@ -81,8 +98,18 @@ pub fn flip_toward_features(mesh: &mut Mesh, is_feature: &[bool], on_feature: &[
         {
             continue;
         }
-        mesh.triangles[t1 as usize] = [c, a, d];
-        mesh.triangles[t2 as usize] = [d, b, c];
+        let (tri1, tri2) = ([c, a, d], [d, b, c]);
+        if [tri1, tri2].iter().any(|&t| buckets.crosses(mesh, t, &t.map(p), &[t1, t2])) {
+            continue;
+        }
+        for t in [t1, t2] {
+            buckets.remove(t, &mesh.corners(t as usize));
+        }
+        mesh.triangles[t1 as usize] = tri1;
+        mesh.triangles[t2 as usize] = tri2;
+        for t in [t1, t2] {
+            buckets.insert(t, &mesh.corners(t as usize));
+        }
         directed.remove(&(a, b));
         directed.remove(&(b, a));
         for (edge, t) in [((c, a), t1), ((a, d), t1), ((d, c), t1), ((d, b), t2), ((b, c), t2), ((c, d), t2)]
@@ -120,13 +147,13 @@ mod tests {
             triangles: vec![[0, 2, 1], [0, 1, 3]],
         };
         let feature = [false, false, true, true];
-        assert_eq!(flip_toward_features(&mut mesh, &feature, &feature), 1);
+        assert_eq!(flip_toward_features(&mut mesh, &feature, &feature, Vec3::ONE), 1);
         let has_cd = mesh.triangles.iter().any(|t| t.contains(&2) && t.contains(&3));
         assert!(has_cd);
         for t in 0..2 {
             assert!(mesh.face_normal(t).z > 0.0, "orientation kept");
         }
-        assert_eq!(flip_toward_features(&mut mesh, &feature, &feature), 0, "nothing left to flip");
+        assert_eq!(flip_toward_features(&mut mesh, &feature, &feature, Vec3::ONE), 0, "nothing left to flip");
     }
 
     #[test]
@@ -142,7 +169,12 @@ mod tests {
             triangles: vec![[0, 2, 1], [0, 1, 3]],
         };
         assert_eq!(
-            flip_toward_features(&mut mesh, &[false, false, true, true], &[false, false, true, true]),
+            flip_toward_features(
+                &mut mesh,
+                &[false, false, true, true],
+                &[false, false, true, true],
+                Vec3::ONE
+            ),
             0
         );
     }

@@ -18,6 +18,7 @@ pub mod flip;
 pub mod lines;
 pub mod merge;
 pub mod mesh_source;
+pub mod nearby;
 pub mod placement;
 mod plan;
 pub mod point_source;
@@ -37,10 +38,10 @@ use crate::tables::{
 };
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, FeatureKind};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use placement::{Component, Placed};
 use plan::{Plan, EXTRA};
-use untangle::{CellTriangleIndex, OutsideFan, OutsideFans};
+use untangle::OutsideFan;
 use web_time::Instant;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -217,10 +218,11 @@ pub fn mesh_with_sampler(
     // Approximate fan centres are flipped toward too (next to one on its feature): joining
     // neighbouring fan centres takes the chord across a crease out of the mesh.
     let mut outside = outside;
-    let unflipped = if outside.fans.is_empty() { Vec::new() } else { out.mesh.triangles.clone() };
+    let unflipped = if outside.is_empty() { Vec::new() } else { out.mesh.triangles.clone() };
     let flip = |out: &mut EmcMesh, centres: &FanCentres| {
         if options.flip_edges {
-            out.flips = flip::flip_toward_features(&mut out.mesh, &centres.any, &centres.on_feature);
+            out.flips =
+                flip::flip_toward_features(&mut out.mesh, &centres.any, &centres.on_feature, grid.spacing);
         }
     };
     flip(&mut out, &centres);
@@ -263,7 +265,7 @@ fn extract(
     grid: &Grid,
     options: &EmcOptions,
     sampler: &dyn EdgeSampler,
-) -> (EmcMesh, FanCentres, OutsideFans) {
+) -> (EmcMesh, FanCentres, Vec<OutsideFan>) {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -275,7 +277,6 @@ fn extract(
     };
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
-    let mut cell_triangles = CellTriangleIndex::default();
     let mut outside_fans: Vec<OutsideFan> = Vec::new();
     let mut centres = FanCentres::default();
 
@@ -291,7 +292,6 @@ fn extract(
                 if case == 0 || case == 255 {
                     continue;
                 }
-                cell_triangles.start(base, out.mesh.triangles.len());
                 let (polygons, triangles): (&CellPolygons, &CellTriangles) = match options.topology {
                     Topology::Fixed => (&fixed[case as usize], &fixed_tris[case as usize]),
                     Topology::Trilinear => {
@@ -349,19 +349,33 @@ fn extract(
                     }
                     plans.push(Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature });
                 }
-                // Pass 2: where a cell holds several components (sheets close together), a fan
-                // that would cut another component's triangles falls back to MC.
-                for a in 0..plans.len() {
-                    if plans.len() > 1 && plans[a].feature.is_some() {
-                        let rules = options.better_triangles.as_ref();
-                        let fan = plans[a].triangles(&out.mesh.positions, triangles, rules);
+                // Pass 2: where a cell holds several components (sheets close together), their
+                // fans must not cross one another or the others' MC triangles. Each centre stays
+                // inside the cell (an outside one takes its inside placement: it could not be
+                // pulled back later without being decided again), and fans are taken one at a
+                // time, each only if it crosses none of the other components' triangles as they
+                // stand (MC's, or a fan taken before it). MC's triangles do not cross, and every
+                // fan taken keeps it so: the cell is decided once, without a repair afterwards.
+                if plans.len() > 1 {
+                    let rules = options.better_triangles.as_ref();
+                    let positions = &out.mesh.positions;
+                    let mut current: Vec<Vec<[DVec3; 3]>> =
+                        plans.iter().map(|p| p.plain_triangles(positions, triangles, rules)).collect();
+                    for a in 0..plans.len() {
+                        if let Some((placed, _)) = &mut plans[a].feature {
+                            if let Some(inside) = placed.inside.take() {
+                                placed.at = inside;
+                            }
+                        }
+                        let Some(fan) = plans[a].fan_triangles() else { continue };
                         let cuts = (0..plans.len()).filter(|&b| b != a).any(|b| {
-                            let other = plans[b].triangles(&out.mesh.positions, triangles, rules);
-                            fan.iter().any(|t| other.iter().any(|u| triangles_intersect(t, u)))
+                            fan.iter().any(|t| current[b].iter().any(|u| triangles_intersect(t, u)))
                         });
                         if cuts {
                             plans[a].feature = None;
                             out.rejected_features += 1;
+                        } else {
+                            current[a] = fan;
                         }
                     }
                 }
@@ -403,7 +417,7 @@ fn extract(
         }
     }
     out.mesh.normals = normals_of_vertex;
-    (out, centres, OutsideFans { index: cell_triangles, fans: outside_fans })
+    (out, centres, outside_fans)
 }
 
 /// Per vertex: is it the centre of a feature fan (on the feature or approximately), and is it on
@@ -425,8 +439,13 @@ impl FanCentres {
 /// Moves the centres of fans outside their cell that cut a neighbour's triangles back inside
 /// (see [`untangle`]), keeping the feature flags and counts right.
 /// Returns how many moved; those are dropped from `outside`.
-fn pull_back(out: &mut EmcMesh, centres: &mut FanCentres, grid: &Grid, outside: &mut OutsideFans) -> usize {
-    let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid, &outside.index, &mut outside.fans);
+fn pull_back(
+    out: &mut EmcMesh,
+    centres: &mut FanCentres,
+    grid: &Grid,
+    outside: &mut Vec<OutsideFan>,
+) -> usize {
+    let moved = untangle::pull_back_crossing_fans(&mut out.mesh, grid.spacing, outside);
     for fan in &moved {
         let v = fan.vertex as usize;
         out.pulled_back_features += 1;

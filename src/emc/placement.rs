@@ -92,7 +92,10 @@ impl Placement {
 pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
     let at = place_within(solved, kind, component, GROWTH)?;
     let p = at.position;
-    if in_box(p, (component.cell_min, component.cell_max)) {
+    // Strictly inside: a centre in a face of the cell would lay fan triangles in that face, over
+    // the neighbour's (a centre inside is the apex of a cone that meets the boundary only in its
+    // polygon's edges).
+    if p.cmpgt(component.cell_min).all() && p.cmplt(component.cell_max).all() {
         return Some(Placed { at, inside: None });
     }
     let inside = place_within(solved, kind, component, -INSET)?;

@@ -31,27 +31,27 @@ pub(super) struct Plan<'a> {
 pub(super) const EXTRA: u32 = u32::MAX;
 
 impl Plan<'_> {
-    /// The triangles this component would emit, as positions (fan, or as [`Plan::plain`]).
-    pub fn triangles(
+    /// The triangles of this component's fan, as positions, if it has a feature point.
+    pub fn fan_triangles(&self) -> Option<Vec<[DVec3; 3]>> {
+        let n = self.pts.len();
+        let (f, _) = self.feature?;
+        let corner = |q: usize| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3());
+        Some((0..n).map(corner).collect())
+    }
+
+    /// The triangles of [`Plan::plain`], as positions.
+    pub fn plain_triangles(
         &self,
         positions: &[Vec3],
         table: &CellTriangles,
         rules: Option<&PolygonRules>,
     ) -> Vec<[DVec3; 3]> {
-        let n = self.pts.len();
-        match self.feature {
-            Some((f, _)) => (0..n)
-                .map(|q| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3()))
-                .collect(),
-            None => {
-                let (tris, extra) = self.plain(positions, table, rules);
-                let at = |v: u32| match (v, extra) {
-                    (EXTRA, Some(c)) => c.as_dvec3(),
-                    _ => positions[v as usize].as_dvec3(),
-                };
-                tris.iter().map(|t| t.map(at)).collect()
-            }
-        }
+        let (tris, extra) = self.plain(positions, table, rules);
+        let at = |v: u32| match (v, extra) {
+            (EXTRA, Some(c)) => c.as_dvec3(),
+            _ => positions[v as usize].as_dvec3(),
+        };
+        tris.iter().map(|t| t.map(at)).collect()
     }
 
     /// The triangles of the component without a feature point, by vertex id ([`EXTRA`] for an

@@ -236,6 +236,12 @@ fn extract(
         let inner = positions.len() as u32;
         let first = triangles.len();
         if let Some(c) = polygon::triangulate(border, &options.rules, &mut edges, inner, &mut triangles) {
+            // Inside its cell, the inner vertex is the apex of a cone over its border, which lies
+            // on the cell's boundary once merged vertices are back on their grid points (where
+            // `unproject_where_crossing` puts them): that cone crosses nothing. Merged vertices
+            // projected off their grid points can pull the rules' point out of the cell (into the
+            // neighbour's triangles), so it is kept in the cell.
+            let c = in_cell(c, grid, polys[*p].cell);
             let on_surface = if options.project {
                 // On the surface, unless that makes the fan's worst angle worse than in the plane.
                 let on = project(field, options.iso, c, grid, polys[*p].cell);
@@ -296,6 +302,17 @@ fn project(field: &dyn Field, iso: f32, start: Vec3, grid: &Grid, cell: [usize; 
     } else {
         start
     }
+}
+
+/// How far (in cells) inner vertices stay off their cell's faces: a vertex in a face would lay
+/// its triangles over the neighbour's.
+const INNER_INSET: f32 = 1e-2;
+
+/// `p` moved into `cell` shrunk by [`INNER_INSET`] (unchanged where it lies there already).
+fn in_cell(p: Vec3, grid: &Grid, cell: [usize; 3]) -> Vec3 {
+    let lo = grid.position(cell[0], cell[1], cell[2]);
+    let inset = grid.spacing * INNER_INSET;
+    p.clamp(lo + inset, lo + grid.spacing - inset)
 }
 
 /// A few Newton steps from `start` towards `field = iso` along the gradient restricted to the
