@@ -8,7 +8,6 @@ use isoforge::error::Error;
 use isoforge::input;
 use isoforge::mesh::analysis;
 use isoforge::pipeline::{self, Method, Request};
-use isoforge::stats::AnalysisOptions;
 use isoforge::{Grid, Vec3};
 
 #[cfg(target_arch = "wasm32")]
@@ -17,12 +16,7 @@ use wasm_bindgen_test::wasm_bindgen_test as test;
 wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 fn request(method: Method, res: usize) -> Request {
-    Request {
-        method,
-        res,
-        analysis: AnalysisOptions { self_intersections: false, surface_error: false },
-        ..Request::default()
-    }
+    common::bare_request(method, res)
 }
 
 const ALL: [Method; 5] = [Method::Mc, Method::Emc, Method::Dmc, Method::Mcq, Method::Quad];

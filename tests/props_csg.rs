@@ -124,17 +124,9 @@ fn check_sound(
 /// A vertex of a border edge that does not lie on a face of the bounds [-1, 1]³ (grids over
 /// them reach a little past them to whole cells, so "on a face" means beyond 0.999).
 fn border_vertex_inside(mesh: &Mesh) -> Option<isoforge::Vec3> {
-    let mut count = std::collections::HashMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    count
+    common::boundary_edges(mesh)
         .into_iter()
-        .filter(|&(_, n)| n == 1)
-        .flat_map(|((a, b), _)| [a, b])
+        .flatten()
         .map(|v| mesh.positions[v as usize])
         .find(|p| p.abs().max_element() < 0.999)
 }

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{case_seeds, Rng};
+use common::{boundary_edges, case_seeds, Rng};
 use isoforge::mc::Topology;
 use isoforge::mesh::analysis;
 use isoforge::pipeline::{self, Method, Request};
@@ -213,18 +213,6 @@ fn on_one_bounding_face(grid: &Grid, a: Vec3, b: Vec3) -> bool {
         let at = |p: Vec3, x: f32| (p[axis] - x).abs() <= tol[axis];
         (at(a, lo[axis]) && at(b, lo[axis])) || (at(a, hi[axis]) && at(b, hi[axis]))
     })
-}
-
-/// Edges used by exactly one triangle.
-fn boundary_edges(mesh: &Mesh) -> Vec<[u32; 2]> {
-    let mut count = std::collections::HashMap::new();
-    for t in &mesh.triangles {
-        for q in 0..3 {
-            let (a, b) = (t[q], t[(q + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    count.into_iter().filter(|&(_, n)| n == 1).map(|((a, b), _)| [a, b]).collect()
 }
 
 /// What every grid method promises on every grid: finite coordinates, an oriented 2-manifold

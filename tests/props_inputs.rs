@@ -8,13 +8,12 @@
 mod common;
 
 use common::csg::random_tree;
-use common::{case_seeds, Rng};
+use common::{bare_request, boundary_edges, case_seeds, Rng};
 use isoforge::emc::mesh_source::padded_grid;
 use isoforge::expr;
 use isoforge::input::PointCloud;
 use isoforge::mesh::analysis;
-use isoforge::pipeline::{self, Method, Output, Request};
-use isoforge::stats::AnalysisOptions;
+use isoforge::pipeline::{self, Method, Output};
 use isoforge::{Field, Grid, Mesh, Vec3};
 
 #[cfg(target_arch = "wasm32")]
@@ -24,15 +23,6 @@ wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 const CI_CASES: usize = 16;
 
-fn request(method: Method, res: usize) -> Request {
-    Request {
-        method,
-        res,
-        analysis: AnalysisOptions { self_intersections: false, surface_error: false },
-        ..Request::default()
-    }
-}
-
 /// A closed mesh of a random tree with at least one triangle (trees whose parts all fall outside
 /// the bounds are skipped by drawing again) at `coarsest` to `coarsest + 9` cells, and its
 /// program's text.
@@ -41,7 +31,7 @@ fn source_mesh(rng: &mut Rng, coarsest: usize) -> (Mesh, String) {
         let tree = random_tree(rng);
         let program = expr::compile(&tree.text).unwrap();
         let res = coarsest + rng.below(10) as usize;
-        let out = pipeline::mesh_program(&program, &request(Method::Mc, res)).unwrap();
+        let out = pipeline::mesh_program(&program, &bare_request(Method::Mc, res)).unwrap();
         if out.stats.closed_manifold && out.mesh.triangle_count() > 0 {
             return (out.mesh, tree.text);
         }
@@ -126,18 +116,9 @@ fn assert_open_only_on_the_grid(out: &Output, grid: &Grid, what: &str) -> analys
         );
     }
     let on_face = |p: Vec3| (0..3).any(|a| (p[a] - lo[a]).abs() < slack || (p[a] - hi[a]).abs() < slack);
-    let mut uses = std::collections::HashMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    for ((a, b), n) in uses {
-        if n == 1 {
-            let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-            assert!(on_face(pa) && on_face(pb), "{what}: border edge {pa} {pb} inside the grid");
-        }
+    for [a, b] in boundary_edges(mesh) {
+        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+        assert!(on_face(pa) && on_face(pb), "{what}: border edge {pa} {pb} inside the grid");
     }
     topo
 }
@@ -152,13 +133,13 @@ fn prop_meshes_remesh_closed_with_mcs_topology() {
         let mut rng = Rng::new(seed);
         let (source, text) = source_mesh(&mut rng, 12);
         let res = 16 + rng.below(12) as usize;
-        let clean_mc = pipeline::mesh_triangles(&source, &request(Method::Mc, res)).unwrap();
+        let clean_mc = pipeline::mesh_triangles(&source, &bare_request(Method::Mc, res)).unwrap();
         for damage in DAMAGES {
             let input = damaged(&mut rng, &source, damage);
             let what = format!("seed {seed}, res {res}, {damage:?} mesh of {text}");
-            let mc = pipeline::mesh_triangles(&input, &request(Method::Mc, res))
+            let mc = pipeline::mesh_triangles(&input, &bare_request(Method::Mc, res))
                 .unwrap_or_else(|e| panic!("{what}: mc refused it: {e}"));
-            let emc = pipeline::mesh_triangles(&input, &request(Method::Emc, res))
+            let emc = pipeline::mesh_triangles(&input, &bare_request(Method::Emc, res))
                 .unwrap_or_else(|e| panic!("{what}: emc refused it: {e}"));
             let mc_topo = assert_closed(&mc, &format!("mc, {what}"));
             let emc_topo = assert_closed(&emc, &format!("emc, {what}"));
@@ -197,9 +178,9 @@ fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
         let cloud = PointCloud { positions: source.positions.clone(), normals };
         let res = 12 + rng.below(12) as usize;
         let what = format!("seed {seed}, res {res}, {} points of {text}", cloud.positions.len());
-        let mc = pipeline::mesh_points(&cloud, &request(Method::Mc, res))
+        let mc = pipeline::mesh_points(&cloud, &bare_request(Method::Mc, res))
             .unwrap_or_else(|e| panic!("{what}: mc refused it: {e}"));
-        let emc = pipeline::mesh_points(&cloud, &request(Method::Emc, res))
+        let emc = pipeline::mesh_points(&cloud, &bare_request(Method::Emc, res))
             .unwrap_or_else(|e| panic!("{what}: emc refused it: {e}"));
         let (lo, hi) = cloud.bounds();
         let grid = padded_grid(lo, hi, res).unwrap();

@@ -56,6 +56,32 @@ pub fn case_seeds(seed_base: u64, ci: usize) -> Vec<u64> {
     (0..count).map(|n| seed_base + n).collect()
 }
 
+/// A request for `method` at `res` cells with the stats' costly analyses off (the suites check
+/// what they need themselves).
+pub fn bare_request(method: isoforge::pipeline::Method, res: usize) -> isoforge::pipeline::Request {
+    isoforge::pipeline::Request {
+        method,
+        res,
+        analysis: isoforge::stats::AnalysisOptions { self_intersections: false, surface_error: false },
+        ..isoforge::pipeline::Request::default()
+    }
+}
+
+/// The edges that only one triangle uses (a mesh's border), as vertex pairs.
+pub fn boundary_edges(mesh: &Mesh) -> Vec<[u32; 2]> {
+    let mut count = std::collections::HashMap::new();
+    for t in &mesh.triangles {
+        for q in 0..3 {
+            let (a, b) = (t[q], t[(q + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut edges: Vec<[u32; 2]> =
+        count.into_iter().filter(|&(_, n)| n == 1).map(|((a, b), _)| [a, b]).collect();
+    edges.sort_unstable();
+    edges
+}
+
 /// Asserts the properties every closed output must have, with a message naming what broke.
 pub fn assert_watertight(mesh: &Mesh, what: &str) -> analysis::Topology {
     let topo = analysis::topology(mesh);
