@@ -235,3 +235,44 @@ fn prop_emc_does_not_cross_itself() {
         sound(case, "emc", &emc.mesh, mc_closed(&mc), CROSSING_FREE);
     });
 }
+
+/// DMC with the topology of MC on its finest grid, where that grid resolves the tree (MC at
+/// twice the resolution agrees): the promise issue 16's rebuild is to keep. Not kept yet: the
+/// top-down octree misses parts its few samples per cell do not see (a hollow ball meshes to
+/// nothing, see `dmc_misses_the_hollow_ball`).
+#[test]
+#[ignore = "DMC's topology differs from fine MC's on some random trees (issue 16)"]
+fn prop_dmc_keeps_fine_mcs_topology() {
+    for_trees(8_500_000, |case| {
+        let finest = case.res.next_power_of_two();
+        let at = |res: usize| Case {
+            res,
+            seed: case.seed,
+            tree: case.tree.clone(),
+            program: case.program.clone(),
+        };
+        let (fine, finer) =
+            (at(finest).mesh(Method::Mc, Topology::Fixed), at(2 * finest).mesh(Method::Mc, Topology::Fixed));
+        let resolved = mc_closed(&fine)
+            && (fine.stats.euler, fine.stats.components) == (finer.stats.euler, finer.stats.components);
+        if !resolved {
+            return;
+        }
+        let dmc = case.mesh(Method::Dmc, Topology::Fixed);
+        assert_eq!(
+            (dmc.stats.euler, dmc.stats.components),
+            (fine.stats.euler, fine.stats.components),
+            "dmc vs mc at {finest} cells\n{}",
+            case.describe()
+        );
+    });
+}
+
+/// The hollow ball of issue 15: DMC's octree of one leaf meshes it to nothing (MC: two spheres).
+#[test]
+#[ignore = "DMC misses the hollow ball (issue 16)"]
+fn dmc_misses_the_hollow_ball() {
+    let program = expr::compile("subtract(sphere(0.5), sphere(0.3))").unwrap();
+    let out = pipeline::mesh_program(&program, &common::bare_request(Method::Dmc, 32)).unwrap();
+    assert_eq!((out.stats.euler, out.stats.components), (4, 2), "dmc on the hollow ball");
+}
