@@ -94,6 +94,18 @@ fn expr_parse_interval_of_max_with_a_nan_constant() {
     }
 }
 
+/// `expr_parse`, minimised by `cargo fuzz tmin`: `pow`'s bounds took a base of -0 for a
+/// non-negative one and bounded `(-0)^x` by [0, inf], but `(-0)^-1` is -inf.
+#[test]
+fn expr_parse_interval_of_negative_zero_to_a_power() {
+    let program = expr::compile("(-0)^x").unwrap();
+    let (a, b) = program.eval_interval(Vec3::splat(-1.0), Vec3::ONE);
+    for x in [-1.0, -0.5, 0.0, 0.5, 1.0] {
+        let v = program.eval(Vec3::new(x, 0.0, 0.0));
+        assert!(v.is_nan() || (a <= v && v <= b), "{v} at x = {x} outside its interval [{a}, {b}]");
+    }
+}
+
 /// `read_points` (libFuzzer could not shrink it further): a binary little-endian PLY whose first
 /// normal is (1.4e-45, -2.7e-23, 0). Its squared length underflows, so `normalize` divided by a
 /// wrong length and returned a normal 0.71 long. Now scaled by its largest component first: the

@@ -185,7 +185,8 @@ impl Interval {
 
     fn pow(self, e: Interval) -> Interval {
         let constant_fraction = e.lo == e.hi && e.lo.fract() != 0.0;
-        if self.lo < 0.0 && !constant_fraction {
+        // -0 counts as negative: (-0)^-1 is -inf (found by the expr_parse fuzz target).
+        if self.lo.is_sign_negative() && !constant_fraction {
             // A negative base to an integer power is defined, and its sign flips: give up.
             return Interval::EVERYTHING;
         }
@@ -520,6 +521,8 @@ mod tests {
             "max(x, 0 * exp(1000 + y))",
             // A NaN constant, through an operation that narrows everything to [0, inf].
             "max(abs(0/-0*y), x)",
+            // Not undefined but signed: (-0)^-1 is -inf.
+            "(-0)^x",
         ];
         for text in texts {
             let program = compile(text).unwrap();
