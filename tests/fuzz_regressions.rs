@@ -106,6 +106,21 @@ fn expr_parse_interval_of_negative_zero_to_a_power() {
     }
 }
 
+/// `expr_parse`, minimised by `cargo fuzz tmin`: `0^x` reaches +inf at x = -1, so the plane's
+/// value and the union reach -inf, and `pow`'s bounds treated every negative base to the
+/// fractional power 1/3 as undefined, but `(-inf)^(1/3)` is +inf: the interval ended at 1.
+#[test]
+fn expr_parse_interval_of_minus_infinity_to_a_fractional_power() {
+    let text = "body= -x ;fin=(plane(0,0,1,0^x )); union(body,rotate(fin, 0,0,3, 8))^ 3^-1";
+    let program = expr::compile(text).unwrap();
+    let (lo, hi) = (Vec3::splat(-1.0), Vec3::ONE);
+    let (a, b) = program.eval_interval(lo, hi);
+    for p in [lo, hi, Vec3::new(-1.0, 0.5, 0.5), Vec3::new(0.5, -1.0, -0.5)] {
+        let v = program.eval(p);
+        assert!(v.is_nan() || (a <= v && v <= b), "{v} at {p} outside its interval [{a}, {b}]");
+    }
+}
+
 /// `read_points` (libFuzzer could not shrink it further): a binary little-endian PLY whose first
 /// normal is (1.4e-45, -2.7e-23, 0). Its squared length underflows, so `normalize` divided by a
 /// wrong length and returned a normal 0.71 long. Now scaled by its largest component first: the

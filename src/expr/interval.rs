@@ -192,7 +192,10 @@ impl Interval {
         }
         // On a >= 0 the extremes of a^b are at the corners (no interior critical points).
         let a = Interval::new(self.lo.max(0.0), self.hi.max(0.0));
-        let c = [a.lo.powf(e.lo), a.lo.powf(e.hi), a.hi.powf(e.lo), a.hi.powf(e.hi)];
+        // Negative bases to a fractional power are NaN, except -inf: (-inf)^(1/3) is +inf and
+        // (-inf)^(-1/3) is +0 (found by the expr_parse fuzz target).
+        let from_minus_infinity = if self.lo == f32::NEG_INFINITY { self.lo.powf(e.lo) } else { f32::NAN };
+        let c = [a.lo.powf(e.lo), a.lo.powf(e.hi), a.hi.powf(e.lo), a.hi.powf(e.hi), from_minus_infinity];
         Interval::hull(&c).widen(2)
     }
 
@@ -523,6 +526,8 @@ mod tests {
             "max(abs(0/-0*y), x)",
             // Not undefined but signed: (-0)^-1 is -inf.
             "(-0)^x",
+            // 0^-1 is inf, so the base of the root reaches -inf, whose cube root is +inf.
+            "max((z - 0^x)^(1/3), x)",
         ];
         for text in texts {
             let program = compile(text).unwrap();
