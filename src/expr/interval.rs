@@ -10,6 +10,12 @@
 //!   out: the bounds describe the points where the program is defined. `sqrt([-1, 4])` is `[0, 2]`.
 //! - Division by an interval containing zero gives `[-inf, inf]`.
 //! - An endpoint is never NaN; a NaN from endpoint arithmetic (`inf - inf`) widens to infinity.
+//! - Leaving undefined points out is only sound while their NaN reaches the result, and `min` and
+//!   `max` stop it: `f32::max(x, NaN)` is `x`. So each interval also records whether the point
+//!   evaluator may produce NaN somewhere in the box ([`Interval::partial`]), and a min/max with a
+//!   partial operand covers the other operand alone too (`max(x, sqrt(z) + 1)` over `z` in
+//!   `[-1, 1]` is `x` where `z < 0`, not at least 1). Choices never drop a partial operand's
+//!   partner for the same reason.
 
 use super::eval::{run, Domain};
 use super::ops::{self, BinaryOp, UnaryOp};
@@ -21,6 +27,10 @@ use std::f64::consts::PI;
 pub struct Interval {
     pub lo: f32,
     pub hi: f32,
+    /// Whether the point evaluator may give NaN somewhere in the box (an operation undefined
+    /// there: `sqrt` of a negative, `0 * inf`, ...), those points being left out of the bounds.
+    /// Conservative: `true` may be wrong, `false` never is.
+    pub partial: bool,
 }
 
 impl Default for Interval {
@@ -41,12 +51,13 @@ pub enum Choice {
 }
 
 impl Interval {
-    pub const EVERYTHING: Interval = Interval { lo: f32::NEG_INFINITY, hi: f32::INFINITY };
+    pub const EVERYTHING: Interval = Interval { lo: f32::NEG_INFINITY, hi: f32::INFINITY, partial: false };
 
     pub fn new(lo: f32, hi: f32) -> Interval {
         Interval {
             lo: if lo.is_nan() { f32::NEG_INFINITY } else { lo },
             hi: if hi.is_nan() { f32::INFINITY } else { hi },
+            partial: false,
         }
     }
 
@@ -61,6 +72,15 @@ impl Interval {
 
     fn contains_zero(self) -> bool {
         self.lo <= 0.0 && self.hi >= 0.0
+    }
+
+    fn reaches_infinity(self) -> bool {
+        !(self.lo.is_finite() && self.hi.is_finite())
+    }
+
+    /// The smallest interval holding both (flags aside).
+    fn union(self, o: Interval) -> Interval {
+        Interval::new(self.lo.min(o.lo), self.hi.max(o.hi))
     }
 
     /// Applies a non-decreasing function to both ends.
@@ -165,13 +185,17 @@ impl Interval {
 
     fn pow(self, e: Interval) -> Interval {
         let constant_fraction = e.lo == e.hi && e.lo.fract() != 0.0;
-        if self.lo < 0.0 && !constant_fraction {
+        // -0 counts as negative: (-0)^-1 is -inf (found by the expr_parse fuzz target).
+        if self.lo.is_sign_negative() && !constant_fraction {
             // A negative base to an integer power is defined, and its sign flips: give up.
             return Interval::EVERYTHING;
         }
         // On a >= 0 the extremes of a^b are at the corners (no interior critical points).
         let a = Interval::new(self.lo.max(0.0), self.hi.max(0.0));
-        let c = [a.lo.powf(e.lo), a.lo.powf(e.hi), a.hi.powf(e.lo), a.hi.powf(e.hi)];
+        // Negative bases to a fractional power are NaN, except -inf: (-inf)^(1/3) is +inf and
+        // (-inf)^(-1/3) is +0 (found by the expr_parse fuzz target).
+        let from_minus_infinity = if self.lo == f32::NEG_INFINITY { self.lo.powf(e.lo) } else { f32::NAN };
+        let c = [a.lo.powf(e.lo), a.lo.powf(e.hi), a.hi.powf(e.lo), a.hi.powf(e.hi), from_minus_infinity];
         Interval::hull(&c).widen(2)
     }
 
@@ -207,52 +231,113 @@ fn next(v: f32, up: bool) -> f32 {
     f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
 }
 
+/// Can `op` give NaN at a point of `a` (itself defined there)?
+fn unary_may_be_undefined(op: UnaryOp, a: Interval) -> bool {
+    match op {
+        UnaryOp::Sqrt | UnaryOp::Ln => a.lo < 0.0,
+        UnaryOp::Asin | UnaryOp::Acos => a.lo < -1.0 || a.hi > 1.0,
+        UnaryOp::Sin | UnaryOp::Cos | UnaryOp::Tan => a.reaches_infinity(),
+        UnaryOp::Neg
+        | UnaryOp::Abs
+        | UnaryOp::Atan
+        | UnaryOp::Exp
+        | UnaryOp::Floor
+        | UnaryOp::Sign
+        | UnaryOp::Powi(_) => false,
+    }
+}
+
+/// Can `op` give NaN at a pair of points of `a` and `b` (both defined there)? Min and max never
+/// do unless both operands are NaN (see [`Interval::partial`]).
+fn binary_may_be_undefined(op: BinaryOp, a: Interval, b: Interval) -> bool {
+    let inf = f32::INFINITY;
+    match op {
+        BinaryOp::Add => (a.hi == inf && b.lo == -inf) || (a.lo == -inf && b.hi == inf),
+        BinaryOp::Sub => (a.hi == inf && b.hi == inf) || (a.lo == -inf && b.lo == -inf),
+        BinaryOp::Mul => {
+            (a.contains_zero() && b.reaches_infinity()) || (b.contains_zero() && a.reaches_infinity())
+        }
+        BinaryOp::Div => {
+            (a.contains_zero() && b.contains_zero()) || (a.reaches_infinity() && b.reaches_infinity())
+        }
+        // A negative base to a fractional power.
+        BinaryOp::Pow => a.lo < 0.0,
+        BinaryOp::Min | BinaryOp::Max | BinaryOp::Atan2 => false,
+    }
+}
+
 impl Domain for Interval {
     fn constant(c: f32) -> Interval {
-        Interval::point(c)
+        // A NaN constant (`0/0` folded) is undefined everywhere: its bounds are everything, and
+        // min/max must still know that they return the other operand there.
+        Interval { partial: c.is_nan(), ..Interval::point(c) }
     }
 
     fn unary(op: UnaryOp, a: Interval) -> Interval {
-        match op {
-            UnaryOp::Neg => Interval::new(-a.hi, -a.lo),
-            UnaryOp::Abs => {
-                if a.lo >= 0.0 {
-                    a
-                } else if a.hi <= 0.0 {
-                    Interval::new(-a.hi, -a.lo)
-                } else {
-                    Interval::new(0.0, (-a.lo).max(a.hi))
-                }
-            }
-            UnaryOp::Sqrt => Interval::new(a.lo.max(0.0), a.hi.max(0.0)).increasing(f32::sqrt),
-            UnaryOp::Sin => a.periodic(f32::sin, PI / 2.0),
-            UnaryOp::Cos => a.periodic(f32::cos, 0.0),
-            UnaryOp::Tan => a.tan(),
-            UnaryOp::Asin => Interval::new(a.lo.max(-1.0), a.hi.min(1.0)).increasing(f32::asin).widen(2),
-            UnaryOp::Acos => {
-                let c = Interval::new(a.lo.max(-1.0), a.hi.min(1.0));
-                Interval::new(c.hi.acos(), c.lo.acos()).widen(2)
-            }
-            UnaryOp::Atan => a.increasing(f32::atan).widen(2),
-            UnaryOp::Exp => a.increasing(f32::exp).widen(2),
-            UnaryOp::Ln => Interval::new(a.lo.max(0.0), a.hi.max(0.0)).increasing(f32::ln).widen(2),
-            UnaryOp::Floor => a.increasing(f32::floor),
-            UnaryOp::Sign => a.increasing(ops::sign),
-            UnaryOp::Powi(n) => a.powi(n),
-        }
+        let partial = a.partial || unary_may_be_undefined(op, a);
+        Interval { partial, ..unary_bounds(op, a) }
     }
 
     fn binary(op: BinaryOp, a: Interval, b: Interval) -> Interval {
-        match op {
-            BinaryOp::Add => Interval::new(a.lo + b.lo, a.hi + b.hi),
-            BinaryOp::Sub => Interval::new(a.lo - b.hi, a.hi - b.lo),
-            BinaryOp::Mul => a.mul(b),
-            BinaryOp::Div => a.div(b),
-            BinaryOp::Min => Interval::new(a.lo.min(b.lo), a.hi.min(b.hi)),
-            BinaryOp::Max => Interval::new(a.lo.max(b.lo), a.hi.max(b.hi)),
-            BinaryOp::Pow => a.pow(b),
-            BinaryOp::Atan2 => Interval::atan2(a, b),
+        let bounds = binary_bounds(op, a, b);
+        if matches!(op, BinaryOp::Min | BinaryOp::Max) {
+            // Where one operand is NaN, f32::min and f32::max return the other one as it is.
+            let mut r = bounds;
+            if a.partial {
+                r = r.union(b);
+            }
+            if b.partial {
+                r = r.union(a);
+            }
+            return Interval { partial: a.partial && b.partial, ..r };
         }
+        let partial = a.partial || b.partial || binary_may_be_undefined(op, a, b);
+        Interval { partial, ..bounds }
+    }
+}
+
+/// The bounds of `op` over `a` at the points where both are defined (flags not set).
+fn unary_bounds(op: UnaryOp, a: Interval) -> Interval {
+    match op {
+        UnaryOp::Neg => Interval::new(-a.hi, -a.lo),
+        UnaryOp::Abs => {
+            if a.lo >= 0.0 {
+                a
+            } else if a.hi <= 0.0 {
+                Interval::new(-a.hi, -a.lo)
+            } else {
+                Interval::new(0.0, (-a.lo).max(a.hi))
+            }
+        }
+        UnaryOp::Sqrt => Interval::new(a.lo.max(0.0), a.hi.max(0.0)).increasing(f32::sqrt),
+        UnaryOp::Sin => a.periodic(f32::sin, PI / 2.0),
+        UnaryOp::Cos => a.periodic(f32::cos, 0.0),
+        UnaryOp::Tan => a.tan(),
+        UnaryOp::Asin => Interval::new(a.lo.max(-1.0), a.hi.min(1.0)).increasing(f32::asin).widen(2),
+        UnaryOp::Acos => {
+            let c = Interval::new(a.lo.max(-1.0), a.hi.min(1.0));
+            Interval::new(c.hi.acos(), c.lo.acos()).widen(2)
+        }
+        UnaryOp::Atan => a.increasing(f32::atan).widen(2),
+        UnaryOp::Exp => a.increasing(f32::exp).widen(2),
+        UnaryOp::Ln => Interval::new(a.lo.max(0.0), a.hi.max(0.0)).increasing(f32::ln).widen(2),
+        UnaryOp::Floor => a.increasing(f32::floor),
+        UnaryOp::Sign => a.increasing(ops::sign),
+        UnaryOp::Powi(n) => a.powi(n),
+    }
+}
+
+/// The bounds of `op` over `a` and `b` at the points where all are defined (flags not set).
+fn binary_bounds(op: BinaryOp, a: Interval, b: Interval) -> Interval {
+    match op {
+        BinaryOp::Add => Interval::new(a.lo + b.lo, a.hi + b.hi),
+        BinaryOp::Sub => Interval::new(a.lo - b.hi, a.hi - b.lo),
+        BinaryOp::Mul => a.mul(b),
+        BinaryOp::Div => a.div(b),
+        BinaryOp::Min => Interval::new(a.lo.min(b.lo), a.hi.min(b.hi)),
+        BinaryOp::Max => Interval::new(a.lo.max(b.lo), a.hi.max(b.hi)),
+        BinaryOp::Pow => a.pow(b),
+        BinaryOp::Atan2 => Interval::atan2(a, b),
     }
 }
 
@@ -275,6 +360,8 @@ pub fn eval_interval_with_choices(tape: &Tape, lo: Vec3, hi: Vec3) -> (Interval,
             BinaryOp::Max => (a.lo >= b.hi, b.lo > a.hi),
             _ => return,
         };
+        // Where the winner is NaN the min/max returns the loser: a partial winner cannot stand in.
+        let (left_wins, right_wins) = (left_wins && !a.partial, right_wins && !b.partial);
         choices.push(if left_wins {
             Choice::Left
         } else if right_wins {
@@ -402,7 +489,9 @@ mod tests {
         let i = Interval::new;
         let u = Interval::unary;
         let pi = std::f32::consts::PI;
-        assert_eq!(u(UnaryOp::Sqrt, i(-1.0, 4.0)), i(0.0, 2.0), "the undefined part is dropped");
+        let root = u(UnaryOp::Sqrt, i(-1.0, 4.0));
+        assert_eq!((root.lo, root.hi), (0.0, 2.0), "the undefined part is dropped");
+        assert!(root.partial && !u(UnaryOp::Sqrt, i(0.0, 4.0)).partial, "and flagged");
         assert_eq!(Interval::binary(BinaryOp::Div, i(1.0, 2.0), i(-1.0, 1.0)), Interval::EVERYTHING);
         assert_eq!(u(UnaryOp::Powi(2), i(-3.0, 2.0)), i(0.0, 9.0));
         assert_eq!(u(UnaryOp::Tan, i(1.0, 2.0)), Interval::EVERYTHING, "a pole at π/2");
@@ -420,6 +509,44 @@ mod tests {
             Interval::binary(BinaryOp::Sub, i(f32::NEG_INFINITY, 0.0), i(f32::NEG_INFINITY, 0.0)).hi,
             f32::INFINITY
         );
+    }
+
+    /// Found by the `expr_parse` fuzz target: `f32::max(x, NaN)` is `x`, so bounds that leave out
+    /// the undefined half of `sqrt(z)` must not claim `max(x, sqrt(z) + 1) >= 1` (DMC's octree
+    /// culled the whole box and meshed nothing).
+    #[test]
+    fn min_and_max_cover_the_other_operand_where_one_is_undefined() {
+        let (lo, hi) = (Vec3::splat(-1.0), Vec3::ONE);
+        let texts = [
+            "max(x, sqrt(z) + 1)",
+            "min(x, -sqrt(z) - 1)",
+            "max(x, z^-0.3)",
+            "max(x, 0 * exp(1000 + y))",
+            // A NaN constant, through an operation that narrows everything to [0, inf].
+            "max(abs(0/-0*y), x)",
+            // Not undefined but signed: (-0)^-1 is -inf.
+            "(-0)^x",
+            // 0^-1 is inf, so the base of the root reaches -inf, whose cube root is +inf.
+            "max((z - 0^x)^(1/3), x)",
+        ];
+        for text in texts {
+            let program = compile(text).unwrap();
+            let (a, b) = program.eval_interval(lo, hi);
+            for p in [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0)] {
+                let v = program.eval(p);
+                assert!(!v.is_nan() && a <= v && v <= b, "{text}: {v} at {p} outside [{a}, {b}]");
+            }
+        }
+        // An operand that wins on its bounds but is undefined somewhere is no choice: where
+        // sqrt(z) is NaN, max gives x.
+        let program = compile("max(sqrt(z) + 2, x)").unwrap();
+        let (_, choices) = program.eval_interval_with_choices(lo, hi);
+        assert_eq!(choices, vec![Choice::Both]);
+        // Both undefined somewhere: the result may be NaN, and is still bounded where it is not.
+        let root = Interval::unary(UnaryOp::Sqrt, Interval::new(-1.0, 4.0));
+        let log = Interval::unary(UnaryOp::Ln, Interval::new(-1.0, 1.0));
+        let both = Interval::binary(BinaryOp::Max, root, log);
+        assert!(both.partial && both.lo == f32::NEG_INFINITY && both.hi == 2.0, "{both:?}");
     }
 
     #[test]

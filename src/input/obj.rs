@@ -39,7 +39,8 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, Error> {
                     let count = positions.len() as i64;
                     let resolved = match i {
                         0 => return Err(fail("vertex index 0; OBJ indices start at 1".into())),
-                        i if i < 0 && -i > count => {
+                        // Not `-i > count`: -i64::MIN overflows (found by the read_mesh fuzz target).
+                        i if i < -count => {
                             return Err(fail(format!("relative index {i} reaches before the first vertex")))
                         }
                         i if i < 0 => count + i,

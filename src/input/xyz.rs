@@ -26,10 +26,9 @@ pub(super) fn read(bytes: &[u8]) -> Result<PointCloud, Error> {
         for (slot, token) in v.iter_mut().zip(&tokens) {
             *slot = parse_f32(token).map_err(&fail)?;
         }
-        let normal = Vec3::new(v[3], v[4], v[5]).normalize_or_zero();
-        if normal == Vec3::ZERO || !normal.is_finite() {
+        let Some(normal) = super::unit_normal(Vec3::new(v[3], v[4], v[5])) else {
             return Err(fail(format!("normal ({}, {}, {}) has no direction", v[3], v[4], v[5])));
-        }
+        };
         cloud.positions.push(Vec3::new(v[0], v[1], v[2]));
         cloud.normals.push(normal);
     }
