@@ -107,13 +107,6 @@ pub struct Request {
     pub max_depth: Option<u8>,
     /// DMC: QEF samples per cell along each axis.
     pub samples_per_cell: usize,
-    /// DMC: the paper's refinement only (see [`DmcOptions::paper_only`]).
-    pub paper_only: bool,
-    /// DMC: refinement rule 3, the triangles' distance to the surface (see
-    /// [`DmcOptions::accuracy_rule`]).
-    pub accuracy_rule: bool,
-    /// DMC: how far a vertex may leave its leaf (see [`DmcOptions::vertex_reach`]).
-    pub vertex_reach: f32,
 }
 
 impl Default for Request {
@@ -140,9 +133,6 @@ impl Default for Request {
             tolerance: DmcOptions::default().tolerance,
             max_depth: None,
             samples_per_cell: DmcOptions::default().samples_per_cell,
-            paper_only: false,
-            accuracy_rule: true,
-            vertex_reach: DmcOptions::default().vertex_reach,
         }
     }
 }
@@ -163,9 +153,6 @@ impl Request {
             max_depth: self.depth(),
             samples_per_cell: self.samples_per_cell,
             max_cells: self.max_cells,
-            paper_only: self.paper_only,
-            accuracy_rule: self.accuracy_rule,
-            vertex_reach: self.vertex_reach,
             ..DmcOptions::default()
         }
     }

@@ -39,7 +39,7 @@ struct Entry {
 
 const CUBE: ([f32; 3], [f32; 3]) = ([-1.0; 3], [1.0; 3]);
 
-const ENTRIES: [Entry; 11] = [
+const ENTRIES: [Entry; 12] = [
     Entry { name: "sphere", min: CUBE.0, max: CUBE.1, euler: Some(2), source: SPHERE },
     Entry { name: "torus", min: CUBE.0, max: CUBE.1, euler: Some(0), source: TORUS },
     // The clipping ball reaches 0.9: ±1.05 keeps it two cells inside at resolution 32.
@@ -65,6 +65,7 @@ const ENTRIES: [Entry; 11] = [
     Entry { name: "rocket", min: [-0.7, -0.7, -1.0], max: [0.7, 0.7, 1.0], euler: Some(2), source: ROCKET },
     Entry { name: "milling", min: [-1.0, -0.8, -0.5], max: [1.0, 0.8, 0.5], euler: Some(2), source: MILLING },
     Entry { name: "cube_with_cutouts", min: CUBE.0, max: CUBE.1, euler: Some(0), source: CUBE_WITH_CUTOUTS },
+    Entry { name: "gear", min: [-0.8, -0.8, -0.3], max: [0.8, 0.8, 0.3], euler: Some(-12), source: GEAR },
 ];
 
 /// The scene names, in a fixed order (the first five are the original analytic scenes).
@@ -168,6 +169,27 @@ corner = translate(sphere(0.4), 0.6, 0.6, 0.6);
 slot = translate(box(0.7, 0.1, 0.15), 0, -0.25, 0.6);            // along x, 0.15 deep
 sink = translate(rotate(cone(0.3, 0.3), 0, 1, 0, 90), -0.65, 0.1, -0.25); // apex towards +x
 subtract(cube, union(hole, corner, slot, sink))
+";
+
+const GEAR: &str = "\
+// A spur gear of 50 primitives: a disc with 40 teeth, a raised hub, a bore with a keyway and six
+// lightening holes. Genus 7 (the bore and the holes): Euler characteristic -12.
+disc = cylinder(0.6, 0.12);
+tooth = translate(box(0.07, 0.024, 0.12), 0.62, 0, 0);
+hub = cylinder(0.24, 0.2);
+bore = cylinder(0.1, 1);
+key = translate(box(0.03, 0.025, 1), 0.11, 0, 0);
+hole = translate(cylinder(0.08, 1), 0.4, 0, 0);
+teeth = union(
+  rotate(tooth, 0, 0, 1, 0), rotate(tooth, 0, 0, 1, 9), rotate(tooth, 0, 0, 1, 18), rotate(tooth, 0, 0, 1, 27), rotate(tooth, 0, 0, 1, 36),
+  rotate(tooth, 0, 0, 1, 45), rotate(tooth, 0, 0, 1, 54), rotate(tooth, 0, 0, 1, 63), rotate(tooth, 0, 0, 1, 72), rotate(tooth, 0, 0, 1, 81),
+  rotate(tooth, 0, 0, 1, 90), rotate(tooth, 0, 0, 1, 99), rotate(tooth, 0, 0, 1, 108), rotate(tooth, 0, 0, 1, 117), rotate(tooth, 0, 0, 1, 126),
+  rotate(tooth, 0, 0, 1, 135), rotate(tooth, 0, 0, 1, 144), rotate(tooth, 0, 0, 1, 153), rotate(tooth, 0, 0, 1, 162), rotate(tooth, 0, 0, 1, 171),
+  rotate(tooth, 0, 0, 1, 180), rotate(tooth, 0, 0, 1, 189), rotate(tooth, 0, 0, 1, 198), rotate(tooth, 0, 0, 1, 207), rotate(tooth, 0, 0, 1, 216),
+  rotate(tooth, 0, 0, 1, 225), rotate(tooth, 0, 0, 1, 234), rotate(tooth, 0, 0, 1, 243), rotate(tooth, 0, 0, 1, 252), rotate(tooth, 0, 0, 1, 261),
+  rotate(tooth, 0, 0, 1, 270), rotate(tooth, 0, 0, 1, 279), rotate(tooth, 0, 0, 1, 288), rotate(tooth, 0, 0, 1, 297), rotate(tooth, 0, 0, 1, 306),
+  rotate(tooth, 0, 0, 1, 315), rotate(tooth, 0, 0, 1, 324), rotate(tooth, 0, 0, 1, 333), rotate(tooth, 0, 0, 1, 342), rotate(tooth, 0, 0, 1, 351));
+subtract(union(disc, hub, teeth), union(bore, key, rotate(hole, 0, 0, 1, 0), rotate(hole, 0, 0, 1, 60), rotate(hole, 0, 0, 1, 120), rotate(hole, 0, 0, 1, 180), rotate(hole, 0, 0, 1, 240), rotate(hole, 0, 0, 1, 300)))
 ";
 
 fn entry(name: &str) -> Result<&'static Entry, Error> {

@@ -11,6 +11,7 @@ mod common;
 
 use common::csg::{random_tree, Tree};
 use common::{case_seeds, Rng};
+use isoforge::dmc::{self, DmcOptions};
 use isoforge::expr::{self, Program};
 use isoforge::mc::Topology;
 use isoforge::mesh::analysis;
@@ -215,8 +216,6 @@ fn prop_mcq_keeps_mcs_topology_without_crossings() {
 }
 
 /// DMC: always closed (the shape is clipped to the bounds), outward, crossing- and fold-free.
-/// Its topology is not promised (see the README: the top-down octree can miss parts its samples
-/// do not see), so it is not compared with MC's here.
 #[test]
 fn prop_dmc_is_closed_and_crossing_free() {
     for_trees(4_500_000, |case| {
@@ -237,11 +236,8 @@ fn prop_emc_does_not_cross_itself() {
 }
 
 /// DMC with the topology of MC on its finest grid, where that grid resolves the tree (MC at
-/// twice the resolution agrees): the promise issue 16's rebuild is to keep. Not kept yet: the
-/// top-down octree misses parts its few samples per cell do not see (a hollow ball meshes to
-/// nothing, see `dmc_meshes_the_hollow_ball`).
+/// twice the resolution agrees).
 #[test]
-#[ignore = "DMC's topology differs from fine MC's on some random trees (issue 16)"]
 fn prop_dmc_keeps_fine_mcs_topology() {
     for_trees(8_500_000, |case| {
         let finest = case.res.next_power_of_two();
@@ -268,11 +264,37 @@ fn prop_dmc_keeps_fine_mcs_topology() {
     });
 }
 
-/// The hollow ball of issue 15: DMC's octree of one leaf meshes it to nothing (MC: two spheres).
+/// DMC's simplification keeps the topology of its own finest level, unsimplified: every merge
+/// passed the safety test (`dmc::safety`), so this holds by construction and for every tree,
+/// resolved or not.
 #[test]
-#[ignore = "DMC misses the hollow ball (issue 16)"]
-fn dmc_meshes_the_hollow_ball() {
-    let program = expr::compile("subtract(sphere(0.5), sphere(0.3))").unwrap();
-    let out = pipeline::mesh_program(&program, &common::bare_request(Method::Dmc, 32)).unwrap();
-    assert_eq!((out.stats.euler, out.stats.components), (4, 2), "dmc on the hollow ball");
+fn prop_dmc_simplification_keeps_the_finest_levels_topology() {
+    for_trees(9_500_000, |case| {
+        let max_depth = case.res.next_power_of_two().trailing_zeros() as u8;
+        let options = DmcOptions { max_depth, ..DmcOptions::default() };
+        let (min, max) = pipeline::DEFAULT_BOUNDS;
+        let topology = |options: &DmcOptions| {
+            let (mesh, _) = dmc::mesh_field(&case.program, min, max, options)
+                .unwrap_or_else(|e| panic!("dmc failed: {e}\n{}", case.describe()));
+            let topo = analysis::topology(&mesh);
+            (topo.euler, topo.components, topo.is_closed_manifold())
+        };
+        let simplified = topology(&options);
+        let finest = topology(&DmcOptions { simplify: false, ..options });
+        assert_eq!(simplified, finest, "dmc simplified vs its finest level\n{}", case.describe());
+    });
+}
+
+/// The hollow ball of issue 15 (MC: two spheres), at shell thicknesses from a third of the
+/// bounds down to a tenth of a finest cell: the crust is found by interval bounds, never by
+/// samples, so no shell is missed.
+#[test]
+fn dmc_meshes_hollow_balls_of_any_thickness() {
+    for thickness in [0.3, 0.05, 0.02, 0.01, 0.006] {
+        let text = format!("subtract(sphere(0.5), sphere({}))", 0.5 - thickness);
+        let program = expr::compile(&text).unwrap();
+        let out = pipeline::mesh_program(&program, &common::bare_request(Method::Dmc, 32)).unwrap();
+        assert_eq!((out.stats.euler, out.stats.components), (4, 2), "dmc on {text} (cells 1/16)");
+        assert!(out.stats.closed_manifold, "{text}");
+    }
 }

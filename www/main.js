@@ -32,11 +32,11 @@ function frame(b) {
   camera.far = r * 20;
 }
 
-/** Options for one pane's method: grid methods take a resolution, DMC a tolerance, depth and reach. */
+/** Options for one pane's method: grid methods take a resolution, DMC a tolerance and depth. */
 function options(method) {
   const common = { bounds };
   if (method === 'dmc') {
-    return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value), vertexReach: Number($('reach').value) };
+    return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
   }
   const grid = { ...common, res: Number($('res').value) };
   if (method === 'emc') return { ...grid, thetaSharp: Number($('theta').value), phiCorner: Number($('phi').value) };

@@ -120,28 +120,16 @@ struct MeshArgs {
     /// one neighbouring crossing whose triangles lie in one plane.
     #[arg(long)]
     no_flat_merge: bool,
-    /// DMC: error tolerance as a fraction of the bounds' longest side (QEF residual and triangle
-    /// distance to the surface).
+    /// DMC: error tolerance as a fraction of the bounds' longest side (the QEF residual a merged
+    /// leaf may have).
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().tolerance)]
     tol: f32,
     /// DMC: deepest octree level [default: the depth whose finest cells match --res].
     #[arg(long)]
     max_depth: Option<u8>,
-    /// DMC: QEF samples per cell along each axis.
+    /// DMC: QEF samples per finest cell along each axis, its corners included.
     #[arg(long, default_value_t = isoforge::dmc::DmcOptions::default().samples_per_cell)]
     samples_per_cell: usize,
-    /// DMC: refine by the QEF residual only, as the paper does (measurement: rules 3-5 and the
-    /// centring fallback off; the mesh may fold or self-intersect).
-    #[arg(long)]
-    paper_only: bool,
-    /// DMC: no refinement by the triangles' distance to the surface (rule 3); the QEF residual and
-    /// the fold and intersection rules still refine.
-    #[arg(long)]
-    no_accuracy_rule: bool,
-    /// DMC: how far beyond its leaf a vertex may follow its QEF minimiser, as a fraction of the
-    /// leaf's side (0: kept in the leaf; 0.25 meshes thin-walled rooms within 1 % with few triangles)
-    #[arg(long, default_value_t = 0.0)]
-    vertex_reach: f32,
     /// MCQ: merge vertices closer than this many cells to a grid point onto it (0: no snapping).
     #[arg(long, default_value_t = isoforge::mcq::DEFAULT_SNAP)]
     snap: f32,
@@ -232,9 +220,6 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         tolerance: args.tol,
         max_depth: args.max_depth,
         samples_per_cell: args.samples_per_cell,
-        paper_only: args.paper_only,
-        accuracy_rule: !args.no_accuracy_rule,
-        vertex_reach: args.vertex_reach,
         ..Request::default()
     };
     let out = mesh_input(&args, &request)?;

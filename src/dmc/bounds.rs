@@ -1,14 +1,11 @@
-//! The octree's root is a cube around the requested bounds, larger than them when they are not
-//! cubic (and always a little larger, see `ROOT_GROWTH`). What lies outside the bounds must not be
-//! meshed (the user asked for the bounds), and a field that is not finite there must not fail the
-//! run. [`Clipped`] is the field intersected with the bounds box, `max(f, iso + box)`: where the
-//! solid reaches a face of the box the surface closes on that face, so the output stays a closed
-//! solid inside the bounds. For an exact distance whose shape lies inside the bounds it is the
-//! field itself everywhere (a point's distance to the shape is at least its distance to the box),
-//! so the octree over such a part is the one it always was. Outside the bounds, where the field
-//! is not finite, it continues from the bounds instead: the field on the box plus the largest
-//! per-axis distance to it, positive. The octree still takes finite samples a little outside
-//! non-cubic bounds; an octree that covers exactly the bounds is the next step of DMC's rebuild.
+//! The octree covers the finest grid exactly (the bounds grown to whole finest cells, as Marching
+//! Cubes' grid is), and every sample and vertex lies in it. [`Clipped`] is the field intersected
+//! with that box, `max(f, iso + box)`: where the solid reaches a face of the box the surface closes
+//! on that face, so the output stays a closed solid inside the bounds. For an exact distance whose
+//! shape lies inside the bounds it is the field itself everywhere (a point's distance to the shape
+//! is at least its distance to the box). Outside the box, where a field may not be finite, it
+//! continues from the box instead: the field on the box plus the largest per-axis distance to it,
+//! positive (only root finding between a vertex and its copy on the box's face comes near).
 
 use crate::field::Field;
 use glam::Vec3;
@@ -70,6 +67,28 @@ impl Clipped<'_> {
         }
         let free = Vec3::select(out.cmpeq(Vec3::ZERO), Vec3::ONE, Vec3::ZERO);
         self.field.gradient(c).map(|g| g * free + away)
+    }
+}
+
+impl Clipped<'_> {
+    /// Values and gradients (central differences of step `h` where the field has none) at many
+    /// points, each of the field's batches called once.
+    pub fn values_and_gradients(&self, points: &[Vec3], h: f32) -> (Vec<f32>, Vec<Vec3>) {
+        let mut raw = vec![0.0; points.len()];
+        self.field.values(points, &mut raw);
+        let mut exact = vec![None; points.len()];
+        self.field.gradients(points, &mut exact);
+        let values = raw.iter().zip(points).map(|(&v, &p)| self.combine(v, p)).collect();
+        let gradients = raw
+            .iter()
+            .zip(points)
+            .zip(&exact)
+            .map(|((&v, &p), &g)| {
+                self.combine_gradient(v, g, p)
+                    .unwrap_or_else(|| crate::field::finite_difference_gradient(self, p, h))
+            })
+            .collect();
+        (values, gradients)
     }
 }
 
@@ -156,15 +175,15 @@ mod tests {
 
     /// An exact distance whose shape lies inside the bounds is its own clip, values and gradients
     /// alike, so DMC's octree over such a part is the one it was before the field was clipped:
-    /// every scene, over the whole of its octree's root.
+    /// every scene, over the whole of its finest grid.
     #[test]
     fn every_scene_is_its_own_clip() {
         for name in crate::scenes::SCENE_NAMES {
             let scene = crate::scenes::scene(name).unwrap();
             let field = scene.field.as_ref();
             let (min, max) = (scene.min, scene.max);
-            let options = crate::dmc::DmcOptions::default();
-            let (root, size, _) = crate::dmc::octree_root(min, max, &options);
+            let grid = crate::dmc::finest_grid(min, max, crate::dmc::DmcOptions::default().max_depth).unwrap();
+            let (root, size) = (grid.origin, grid.max() - grid.origin);
             let clipped = Clipped { field, iso: 0.0, min, max };
             let n = 20;
             for i in 0..=n {

@@ -16,14 +16,64 @@
 //!   on the true surface; linear interpolation of the two values would be exact only for fields
 //!   linear along the edge.
 
-use super::features::DualVertices;
-use super::memo::Memo;
+use super::dual::VertexKey;
+use super::tree::{Kind, Octree};
 use crate::emc::edges::edge_root;
 use crate::field::Field;
 use crate::mesh::Mesh;
 use crate::tables::{triangle_table, CENTER, EDGES};
 use glam::Vec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
+
+/// The dual vertices the contour uses: position, `f - iso` and side, numbered densely.
+#[derive(Debug, Default)]
+pub struct DualVertices {
+    pub positions: Vec<Vec3>,
+    pub values: Vec<f32>,
+    pub inside: Vec<bool>,
+    ids: HashMap<VertexKey, u32>,
+    /// Vertices whose value is only a sign so far (empty leaves, boundary copies).
+    unknown: Vec<u32>,
+}
+
+impl DualVertices {
+    /// The id of `key`'s vertex: a leaf's own, or a leaf's projected onto the grid's faces.
+    pub fn id(&mut self, tree: &Octree, key: VertexKey) -> u32 {
+        if let Some(&id) = self.ids.get(&key) {
+            return id;
+        }
+        let node = &tree.nodes[key.node as usize];
+        let p = super::dual::position(tree, key);
+        let id = self.positions.len() as u32;
+        let exact = key.clamp == 0 && node.kind == Kind::Surface;
+        if !exact {
+            self.unknown.push(id);
+        }
+        self.positions.push(p);
+        self.values.push(node.value);
+        self.inside.push(super::dual::inside(tree, key));
+        self.ids.insert(key, id);
+        id
+    }
+
+    /// Evaluates the values known only by their sign.
+    pub fn evaluate(&mut self, field: &dyn Field, iso: f32) {
+        let points: Vec<Vec3> = self.unknown.iter().map(|&i| self.positions[i as usize]).collect();
+        let mut values = vec![0.0; points.len()];
+        field.values(&points, &mut values);
+        for (&i, v) in self.unknown.iter().zip(values) {
+            // Keep the side the bound proved (a value at the level counts as outside).
+            let inside = self.inside[i as usize];
+            let v = v - iso;
+            self.values[i as usize] = match inside {
+                true if v < 0.0 => v,
+                true => -f32::MIN_POSITIVE,
+                false => v.max(0.0),
+            };
+        }
+        self.unknown.clear();
+    }
+}
 
 /// A mesh vertex on a dual edge: the dual vertices at its inside and outside ends, and how far
 /// from the inside end it lies (fraction of the edge).
@@ -44,21 +94,14 @@ pub struct Contour {
 }
 
 /// Contours dual cells given as eight dual vertex ids each (octant order).
-/// Crossings already found in earlier rounds come from `memo`.
-pub fn contour(
-    cells: &[[u32; 8]],
-    vertices: &DualVertices,
-    field: &dyn Field,
-    iso: f32,
-    memo: &mut Memo,
-) -> Contour {
+pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, iso: f32) -> Contour {
     let table = triangle_table();
     let mut out = Contour::default();
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::default();
     for (c, ids) in cells.iter().enumerate() {
         let mut case = 0u8;
         for (corner, &id) in ids.iter().enumerate() {
-            case |= ((vertices.values[id as usize] < 0.0) as u8) << corner;
+            case |= (vertices.inside[id as usize] as u8) << corner;
         }
         if case == 0 || case == 255 {
             continue;
@@ -71,12 +114,13 @@ pub fn contour(
                 let e = e as usize;
                 if local[e] == u32::MAX {
                     let [a, b] = EDGES[e].map(|corner| ids[corner as usize]);
-                    let (inside, outside) = if vertices.values[a as usize] < 0.0 { (a, b) } else { (b, a) };
+                    let (inside, outside) = if vertices.inside[a as usize] { (a, b) } else { (b, a) };
                     local[e] = *edges.entry((inside, outside)).or_insert_with(|| {
-                        let t = crossing(vertices, field, iso, inside, outside, memo);
-                        out.crossings.push(Crossing { inside, outside, t });
                         let (pa, pb) =
                             (vertices.positions[inside as usize], vertices.positions[outside as usize]);
+                        let (va, vb) = (vertices.values[inside as usize], vertices.values[outside as usize]);
+                        let t = edge_root(field, iso, pa, pb, va, vb);
+                        out.crossings.push(Crossing { inside, outside, t });
                         out.mesh.positions.push(pa + (pb - pa) * t);
                         out.mesh.positions.len() as u32 - 1
                     });
@@ -92,40 +136,7 @@ pub fn contour(
     out
 }
 
-fn crossing(
-    vertices: &DualVertices,
-    field: &dyn Field,
-    iso: f32,
-    inside: u32,
-    outside: u32,
-    memo: &mut Memo,
-) -> f32 {
-    let (pa, pb) = (vertices.positions[inside as usize], vertices.positions[outside as usize]);
-    let (va, vb) = (vertices.values[inside as usize], vertices.values[outside as usize]);
-    memo.crossing(pa, va, pb, vb, || edge_root(field, iso, pa, pb, va, vb))
-}
-
 /// Unit normals from the field's gradient (central differences where it has none).
 pub fn field_normals(mesh: &mut Mesh, field: &dyn Field, h: f32) {
     mesh.normals = mesh.positions.iter().map(|&p| crate::emc::edges::field_normal(field, p, h)).collect();
-}
-
-/// The largest estimated distance from `field`'s zero set (`|f - iso| / |∇f|`) over a triangle's
-/// centroid and edge midpoints: how far the flat triangle strays from the surface between its
-/// exact vertices.
-pub fn triangle_error(mesh: &Mesh, t: usize, field: &dyn Field, iso: f32, h: f32) -> f32 {
-    let [a, b, c] = mesh.corners(t);
-    [(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]
-        .into_iter()
-        .map(|p: Vec3| {
-            let g = crate::field::gradient_or_differences(field, p, h);
-            let len = g.length();
-            let d = (field.value(p) - iso).abs();
-            if len > 1e-12 {
-                d / len
-            } else {
-                d
-            }
-        })
-        .fold(0.0, f32::max)
 }

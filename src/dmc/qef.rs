@@ -70,6 +70,25 @@ impl Qef {
         self.count += 1;
     }
 
+    /// Adds `other`'s planes: a parent's QEF is the sum of its children's, moved to its origin.
+    pub fn merge(&mut self, other: &Qef) {
+        // other's planes are in y2 = y + d, d = (self.origin - other.origin, 0).
+        let d3 = self.origin - other.origin;
+        let d = Vector4::new(d3.x, d3.y, d3.z, 0.0);
+        let a = other.matrix();
+        let b = Vector4::from(other.atb);
+        let ad = a * d;
+        let shifted_b = b - ad;
+        for (k, v) in other.ata.iter().enumerate() {
+            self.ata[k] += v;
+        }
+        for i in 0..4 {
+            self.atb[i] += shifted_b[i];
+        }
+        self.btb += other.btb + d.dot(&ad) - 2.0 * b.dot(&d);
+        self.count += other.count;
+    }
+
     /// How many independent directions the samples' planes fix (singular values of `A` above the
     /// cutoff): 1 where the function is locally linear, 2 on a crease, 3 or 4 at a corner.
     pub fn rank(&self) -> usize {
@@ -231,6 +250,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Merging QEFs kept about different origins is the QEF of all their planes together.
+    #[test]
+    fn merged_qefs_are_the_qef_of_all_their_samples() {
+        let f = |p: Vec3| {
+            let (a, b) = (p.x + 0.2 * p.y - 0.3, -p.x + p.z * 0.5 - 0.1);
+            if a > b {
+                (a, Vec3::new(1.0, 0.2, 0.0))
+            } else {
+                (b, Vec3::new(-1.0, 0.0, 0.5))
+            }
+        };
+        let (lo1, hi1) = (Vec3::splat(-1.0), Vec3::new(0.0, 1.0, 1.0));
+        let (lo2, hi2) = (Vec3::new(0.0, -1.0, -1.0), Vec3::splat(1.0));
+        let (mut a, mut b) = (Qef::new((lo1 + hi1) * 0.5), Qef::new((lo2 + hi2) * 0.5));
+        sample(&mut a, lo1, hi1, 3, f);
+        sample(&mut b, lo2, hi2, 3, f);
+        let mut all = Qef::new(Vec3::new(0.1, 0.2, -0.3));
+        sample(&mut all, lo1, hi1, 3, f);
+        sample(&mut all, lo2, hi2, 3, f);
+        let mut merged = Qef::new(Vec3::new(0.1, 0.2, -0.3));
+        merged.merge(&a);
+        merged.merge(&b);
+        let (lo, hi) = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let (s, t) = (merged.minimise_in_box(lo, hi, None), all.minimise_in_box(lo, hi, None));
+        assert_eq!(merged.count(), 54);
+        assert!((s.position - t.position).length() < 1e-9 && (s.value - t.value).abs() < 1e-9, "{s:?} {t:?}");
+        assert!((s.rms - t.rms).abs() < 1e-9, "{s:?} {t:?}");
     }
 
     #[test]

@@ -35,9 +35,6 @@ struct JsOptions {
     tolerance: Option<f32>,
     max_depth: Option<f64>,
     samples_per_cell: Option<f64>,
-    vertex_reach: Option<f32>,
-    paper_only: Option<bool>,
-    accuracy_rule: Option<bool>,
     snap: Option<f32>,
     project: Option<bool>,
     dtype: Option<String>,
@@ -109,9 +106,6 @@ pub(super) fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dt
     r.resample_creases = o.resample_creases.unwrap_or(r.resample_creases);
     r.merge_flat = o.merge_flat.unwrap_or(r.merge_flat);
     r.tolerance = o.tolerance.unwrap_or(r.tolerance);
-    r.vertex_reach = o.vertex_reach.unwrap_or(r.vertex_reach);
-    r.paper_only = o.paper_only.unwrap_or(r.paper_only);
-    r.accuracy_rule = o.accuracy_rule.unwrap_or(r.accuracy_rule);
     let whole = |name: &str, v: f64, max: f64| {
         if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= max {
             Ok(v)

@@ -68,16 +68,6 @@ export interface MeshOptions {
   maxDepth?: number;
   /** DMC: QEF samples per cell along each axis, 2 to 16 (default 4). */
   samplesPerCell?: number;
-  /**
-   * DMC: how far, as a fraction of its leaf's side (0 to 1, default 0), a leaf's vertex may follow
-   * its QEF minimiser out of the leaf; 0.25 with tolerance 0.01 meshes the thin-walled room in
-   * under 1 000 triangles within 1 % (see the README).
-   */
-  vertexReach?: number;
-  /** DMC: the paper's refinement only, the QEF residual split (default false; see the README). */
-  paperOnly?: boolean;
-  /** DMC: refinement rule 3, the triangles' distance to the surface (default true). */
-  accuracyRule?: boolean;
   /** MCQ: merge vertices closer than this many cells to a grid point onto it (default 0.3; 0 turns snapping off). */
   snap?: number;
   /** MCQ: project inserted and merged vertices onto the surface (default true; the paper does not). */

@@ -1,0 +1,244 @@
+//! The finest level, built once: the *crust* (every finest cell the surface may reach) found top
+//! down by interval bounds, then sampled once.
+//!
+//! **Never missing the surface.** A node is split while its interval bound contains the iso-level,
+//! down to the finest level; a node becomes a coarse leaf only when its bound excludes the level,
+//! which proves it wholly inside or wholly outside. No sample decides that a cell is empty, so a
+//! shell thinner than any sample spacing is still found. A field without bounds makes every finest
+//! cell crust (and the work cap applies to all of them).
+//!
+//! **Sampling.** Each crust cell is sampled on a lattice of `samples_per_cell` points per axis, its
+//! corners included, shared with its neighbours, so a cell costs `(samples_per_cell - 1)³` new
+//! samples. Each sample adds the tangent plane of the function's graph to its cell's 4-D QEF
+//! ([`super::qef`]); a parent's QEF is the sum of its children's, so simplification
+//! ([`super::simplify`]) samples nothing more.
+
+use super::qef::Qef;
+use super::tree::{Kind, Octree};
+use crate::error::Error;
+use super::bounds::Clipped;
+use crate::field::Field;
+use glam::Vec3;
+use rustc_hash::FxHashMap as HashMap;
+
+/// A vertex is kept this fraction of its leaf's side inside the leaf: a vertex on a face would make
+/// the dual cells on both sides degenerate there.
+pub const MARGIN: f32 = 1e-3;
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BuildStats {
+    pub crust_cells: usize,
+    pub interval_queries: usize,
+    pub samples: usize,
+}
+
+/// Splits the octree down to the crust. Fails when the crust would take more samples than
+/// `max_cells` (counted as `samples_per_cell³` per crust cell).
+pub fn crust(
+    tree: &mut Octree,
+    field: &dyn Field,
+    iso: f32,
+    samples_per_cell: usize,
+    max_cells: u64,
+) -> Result<BuildStats, Error> {
+    let per_cell = (samples_per_cell as u64).pow(3);
+    let max_crust = (max_cells / per_cell).max(1);
+    let mut stats = BuildStats::default();
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let (lo, hi) = tree.world_box(n);
+        stats.interval_queries += 1;
+        if let Some((a, b)) = field.interval(lo, hi) {
+            if a > iso || b < iso {
+                tree.nodes[n as usize].kind = Kind::Empty { inside: b < iso };
+                continue;
+            }
+        }
+        if tree.nodes[n as usize].level == tree.depth {
+            tree.nodes[n as usize].kind = Kind::Surface;
+            stats.crust_cells += 1;
+            if stats.crust_cells as u64 > max_crust {
+                return Err(Error::InvalidOption(format!(
+                    "the surface crosses more than {max_crust} finest cells of {per_cell} samples each, \
+                     more work than maxCells allows; lower the maximum depth or raise maxCells"
+                )));
+            }
+            continue;
+        }
+        let first = tree.split(n);
+        for c in (0..8).rev() {
+            if tree.nodes[(first + c) as usize].kind != Kind::Absent {
+                stack.push(first + c);
+            }
+        }
+    }
+    Ok(stats)
+}
+
+/// Samples the crust cells, gives each its QEF and its vertex, and puts the vertices of the empty
+/// leaves at their centres. Every value is `f - iso`.
+pub fn sample(
+    tree: &mut Octree,
+    field: &Clipped,
+    iso: f32,
+    samples_per_cell: usize,
+    stats: &mut BuildStats,
+) {
+    let k = (samples_per_cell - 1) as u32;
+    let spacing = tree.h / k as f32;
+    let leaves = tree.leaves();
+    let crust: Vec<u32> =
+        leaves.iter().copied().filter(|&n| tree.nodes[n as usize].kind == Kind::Surface).collect();
+    let mut index: HashMap<u64, u32> = HashMap::with_capacity_and_hasher(crust.len() * (k as usize).pow(3) + 16, Default::default());
+    let mut points = Vec::new();
+    let mut cell_samples = Vec::with_capacity(crust.len() * (samples_per_cell).pow(3));
+    for &n in &crust {
+        let c = tree.nodes[n as usize].coord;
+        for dz in 0..=k {
+            for dy in 0..=k {
+                for dx in 0..=k {
+                    let l = [c[0] * k + dx, c[1] * k + dy, c[2] * k + dz];
+                    let key = super::dual::point_key(l);
+                    let id = *index.entry(key).or_insert_with(|| {
+                        points.push(
+                            tree.origin + Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) * spacing,
+                        );
+                        points.len() as u32 - 1
+                    });
+                    cell_samples.push(id);
+                }
+            }
+        }
+    }
+    stats.samples = points.len();
+    let (values, gradients) = field.values_and_gradients(&points, spacing * 1e-2);
+
+    let per_cell = samples_per_cell.pow(3);
+    let mut vertices = Vec::with_capacity(crust.len());
+    let mut free = Vec::with_capacity(crust.len());
+    for (i, &n) in crust.iter().enumerate() {
+        let (lo, hi) = tree.world_box(n);
+        let mut qef = Qef::new((lo + hi) * 0.5);
+        for &s in &cell_samples[i * per_cell..(i + 1) * per_cell] {
+            let (v, g) = (values[s as usize], gradients[s as usize]);
+            if v.is_finite() && g.is_finite() {
+                qef.add(points[s as usize], v - iso, g);
+            }
+        }
+        let placed = place(&qef, lo, hi);
+        vertices.push(placed.vertex);
+        free.push(placed.free);
+        tree.nodes[n as usize].qef = tree.qefs.len() as u32;
+        tree.qefs.push(qef);
+    }
+    let centres: Vec<Vec3> = crust.iter().map(|&n| {
+        let (lo, hi) = tree.world_box(n);
+        (lo + hi) * 0.5
+    }).collect();
+    let at = settle_vertices(field, iso, &mut vertices, &centres, &free, tree.h);
+    for ((&n, &v), &f) in crust.iter().zip(&vertices).zip(&at) {
+        let node = &mut tree.nodes[n as usize];
+        node.vertex = v;
+        node.value = f;
+    }
+    for &n in &leaves {
+        if let Kind::Empty { inside } = tree.nodes[n as usize].kind {
+            let (lo, hi) = tree.world_box(n);
+            let node = &mut tree.nodes[n as usize];
+            node.vertex = (lo + hi) * 0.5;
+            // The sign is proven by the bound; the value is found only if a crossing needs it.
+            node.value = if inside { -f32::MIN_POSITIVE } else { f32::MIN_POSITIVE };
+        }
+    }
+}
+
+/// Each vertex's value `f - iso`, and the vertex moved where its side had to be decided.
+///
+/// A vertex on a feature often lies *on* the iso-level: on a crease of the surface, or on a ridge
+/// of the field that only touches the level (two parts of a union sharing a face: `min(f1, f2)` is
+/// 0 all over the shared face, inside the solid). Which side such a vertex counts on decides the
+/// topology, and its value is rounding noise: taken as it comes, it makes pinholes in unions and
+/// bubbles beside creases. The same holds for a vertex the leaf's box stopped short of its
+/// minimiser (not `free`): the feature it was drawn to lies in a neighbour, and its side is the
+/// side of a point of that feature's neighbourhood, not of its own leaf (beside a fin's corner,
+/// an isolated inside vertex in an outside leaf: a bubble). So such vertices, and any within
+/// [`LEVEL_BAND`] of a finest cell of the level, take the side of their leaf's centre (the side
+/// Marching Cubes on the lattice of centres would give them) and move toward the centre
+/// (bisection on the segment) until the field agrees. A free vertex clearly off the level keeps
+/// its own side: that is how a wall thinner than a leaf, whose vertex the QEF puts on the wall's
+/// mid-surface, survives.
+pub fn settle_vertices(
+    field: &dyn Field,
+    iso: f32,
+    vertices: &mut [Vec3],
+    centres: &[Vec3],
+    free: &[bool],
+    h: f32,
+) -> Vec<f32> {
+    let mut at = vec![0.0; vertices.len()];
+    field.values(vertices, &mut at);
+    let band = LEVEL_BAND * h;
+    let near: Vec<usize> =
+        (0..at.len()).filter(|&i| (at[i] - iso).abs() <= if free[i] { band } else { band * STOPPED_BAND }).collect();
+    let points: Vec<Vec3> = near.iter().map(|&i| centres[i]).collect();
+    let mut at_centre = vec![0.0; points.len()];
+    field.values(&points, &mut at_centre);
+    for (k, &i) in near.iter().enumerate() {
+        let inside = at_centre[k] < iso;
+        if (at[i] < iso) == inside {
+            continue;
+        }
+        // The field agrees at the centre: find where it starts to, nearest the vertex.
+        let (v, c) = (vertices[i], centres[i]);
+        let (mut bad, mut good) = (0.0f32, 1.0f32);
+        let mut good_value = at_centre[k];
+        for _ in 0..8 {
+            let mid = 0.5 * (bad + good);
+            let f = field.value(v + (c - v) * mid);
+            if (f < iso) == inside {
+                good = mid;
+                good_value = f;
+            } else {
+                bad = mid;
+            }
+        }
+        vertices[i] = v + (c - v) * good;
+        at[i] = good_value;
+    }
+    at.iter().map(|v| v - iso).collect()
+}
+
+/// Vertices this close to the level (fraction of a finest cell) take their leaf centre's side.
+pub const LEVEL_BAND: f32 = 1e-4;
+
+/// How many times wider that band is for vertices stopped on their leaf's boundary.
+pub const STOPPED_BAND: f32 = 500.0;
+
+/// Where a leaf's vertex goes.
+#[derive(Debug, Clone, Copy)]
+pub struct Placed {
+    pub vertex: Vec3,
+    /// The QEF's root-mean-square residual there.
+    pub rms: f64,
+    /// The minimiser lies inside the leaf (not stopped on its boundary).
+    pub free: bool,
+}
+
+/// The QEF's minimiser in the leaf `[lo, hi]` shrunk by [`MARGIN`] (its centre if it has no
+/// samples).
+pub fn place(qef: &Qef, lo: Vec3, hi: Vec3) -> Placed {
+    let margin = (hi - lo) * MARGIN;
+    let (lo, hi) = (lo + margin, hi - margin);
+    let centre = (lo + hi) * 0.5;
+    if qef.count() == 0 {
+        return Placed { vertex: centre, rms: 0.0, free: true };
+    }
+    let s = qef.minimise_in_box(lo, hi, None);
+    let p = s.position.as_vec3();
+    if !p.is_finite() {
+        return Placed { vertex: centre, rms: f64::INFINITY, free: false };
+    }
+    let p = p.clamp(lo, hi);
+    let free = (0..3).all(|a| p[a] > lo[a] && p[a] < hi[a]);
+    Placed { vertex: p, rms: s.rms, free }
+}

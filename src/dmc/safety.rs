@@ -1,0 +1,264 @@
+//! The topological safety test of a merge: replacing a node's eight leaf children by the node
+//! itself, as one leaf with one vertex, must leave the contour's topology as it was.
+//!
+//! A merge changes only the dual cells that have a child (afterwards: the node) among their eight
+//! leaves: the *star* of the merge, the dual cells at the octree vertices in the node's closed box.
+//! The star's outer faces are made of other leaves only, so the contour crosses them in the same
+//! curves before and after (the case table decides a face from its four signs alone). If the
+//! contour inside the star is, before and after, a set of discs each bounded by exactly one of
+//! those curves, then the two are homeomorphic relative to the curves, and gluing the unchanged
+//! rest of the contour back gives a surface homeomorphic to the one before: same components, same
+//! genus, no hole opened or closed. That is what this test checks, combinatorially (Euler
+//! characteristic and boundary loops of each component of the star's contour, every edge on at
+//! most two triangles); it is sufficient, not necessary, so it may refuse a harmless merge (an
+//! annulus kept as an annulus), never accept a harmful one.
+//!
+//! Applied to every merge in turn, the test makes the simplified contour homeomorphic to the
+//! contour of the unsimplified finest level, by induction over the merges. It is our own
+//! criterion, with the guarantee of Ju et al. 2002 §4.2 (their tests are on the signs of a primal
+//! grid; DMC's signs are at the dual vertices, where theirs do not apply).
+
+use super::dual::{self, dual_cell, VertexKey};
+use super::tree::{Kind, Octree, NONE};
+use crate::tables::{triangle_table, EDGES};
+use rustc_hash::FxHashMap as HashMap;
+
+/// A triangle of the contour named by its three dual edges (inside end, outside end).
+pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
+
+/// Whether making internal node `n` (whose children are all leaves) a leaf whose vertex has value
+/// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
+pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriangle>> {
+    let (lo, hi) = tree.int_box(n);
+    let mut shared = Vec::new();
+    neighbour_corners(tree, 0, n, lo, hi, &mut shared);
+    let mut before = shared.clone();
+    let first = tree.nodes[n as usize].children;
+    for c in 0..8 {
+        let child = first + c;
+        if tree.nodes[child as usize].kind != Kind::Absent {
+            push_corners(tree, child, &mut before);
+        }
+    }
+    let mut after = shared;
+    push_corners(tree, n, &mut after);
+    let (before, after) = (unique(before), unique(after));
+    let sign_before = |k: VertexKey| dual::inside(tree, k);
+    let sign_after = |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
+    let mut crossings = Crossings::default();
+    let tris_before = star_triangles(tree, &before, NONE, &sign_before, &mut crossings);
+    let tris_after = star_triangles(tree, &after, n, &sign_after, &mut crossings);
+    let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
+        let mut by_id = vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
+        for (&e, &id) in &crossings.ids {
+            by_id[id as usize] = e;
+        }
+        tris.iter().map(|t| t.map(|v| by_id[v as usize])).collect()
+    };
+    if tris_before.is_empty() && tris_after.is_empty() {
+        return Some(Vec::new());
+    }
+    match (discs_boundary(&tris_before, crossings.len()), discs_boundary(&tris_after, crossings.len())) {
+        (Some(a), Some(b)) if a == b => Some(edges(&tris_after)),
+        _ => None,
+    }
+}
+
+/// The points, each once (in the order of their keys).
+fn unique(points: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+    let mut keys: Vec<u64> = points.iter().map(|&p| dual::point_key(p)).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    let mask = (1u64 << 21) - 1;
+    keys.iter().map(|&k| [(k & mask) as u32, ((k >> 21) & mask) as u32, (k >> 42) as u32]).collect()
+}
+
+/// Lattice points (as `[u32; 3]`) of the corners of leaf `n`.
+fn push_corners(tree: &Octree, n: u32, out: &mut Vec<[u32; 3]>) {
+    let (lo, hi) = tree.int_box(n);
+    for c in 0..8 {
+        out.push(std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] }));
+    }
+}
+
+/// Corners of leaves outside node `skip` that lie on the closed box `[lo, hi]`.
+fn neighbour_corners(tree: &Octree, n: u32, skip: u32, lo: [u32; 3], hi: [u32; 3], out: &mut Vec<[u32; 3]>) {
+    if n == skip {
+        return;
+    }
+    let (nlo, nhi) = tree.int_box(n);
+    if (0..3).any(|a| nhi[a] < lo[a] || nlo[a] > hi[a]) {
+        return;
+    }
+    let node = &tree.nodes[n as usize];
+    match node.kind {
+        Kind::Absent => {}
+        Kind::Internal => {
+            for c in 0..8 {
+                neighbour_corners(tree, node.children + c, skip, lo, hi, out);
+            }
+        }
+        _ => {
+            for c in 0..8 {
+                let p: [u32; 3] = std::array::from_fn(|a| if (c >> a) & 1 == 1 { nhi[a] } else { nlo[a] });
+                if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
+                    out.push(p);
+                }
+            }
+        }
+    }
+}
+
+/// Mesh vertices of the star's contours, named by their dual edge (inside end, outside end) so that
+/// the contours before and after a merge share the names of the crossings they share.
+#[derive(Default)]
+struct Crossings {
+    ids: HashMap<(VertexKey, VertexKey), u32>,
+}
+
+impl Crossings {
+    fn id(&mut self, edge: (VertexKey, VertexKey)) -> u32 {
+        let next = self.ids.len() as u32;
+        *self.ids.entry(edge).or_insert(next)
+    }
+
+    fn len(&self) -> usize {
+        self.ids.len()
+    }
+}
+
+/// The contour's triangles in the dual cells at `points` (with `merged` as a leaf), as crossing ids;
+/// triangles that collapse in a degenerate cell are dropped, as [`super::contour`] drops them.
+fn star_triangles(
+    tree: &Octree,
+    points: &[[u32; 3]],
+    merged: u32,
+    inside: &dyn Fn(VertexKey) -> bool,
+    crossings: &mut Crossings,
+) -> Vec<[u32; 3]> {
+    let table = triangle_table();
+    let mut out = Vec::new();
+    for &p in points {
+        let Some(cell) = dual_cell(tree, p, merged) else { continue };
+        let signs = cell.map(inside);
+        let case = signs.iter().enumerate().fold(0u8, |c, (i, &s)| c | (s as u8) << i);
+        if case == 0 || case == 255 {
+            continue;
+        }
+        for t in table[case as usize].triangles() {
+            let v = t.map(|e| {
+                let [a, b] = EDGES[e as usize].map(|corner| corner as usize);
+                let edge = if signs[a] { (cell[a], cell[b]) } else { (cell[b], cell[a]) };
+                crossings.id(edge)
+            });
+            if v[0] != v[1] && v[1] != v[2] && v[0] != v[2] {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+/// The boundary edges (sorted pairs, sorted) of a triangle set that is a disjoint union of discs,
+/// each bounded by one loop; `None` for anything else (a closed piece, an annulus, a handle, an
+/// edge on three triangles, two pieces meeting at a point).
+fn discs_boundary(tris: &[[u32; 3]], vertices: usize) -> Option<Vec<(u32, u32)>> {
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tris.len() * 3);
+    for t in tris {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            edges.push((a.min(b), a.max(b)));
+        }
+    }
+    edges.sort_unstable();
+    // Distinct edges with their use counts.
+    let mut counted: Vec<((u32, u32), u8)> = Vec::with_capacity(edges.len());
+    for e in edges {
+        match counted.last_mut() {
+            Some((last, uses)) if *last == e => {
+                *uses += 1;
+                if *uses > 2 {
+                    return None;
+                }
+            }
+            _ => counted.push((e, 1)),
+        }
+    }
+    let mut pieces = UnionFind::new(vertices);
+    for t in tris {
+        pieces.union(t[0], t[1]);
+        pieces.union(t[1], t[2]);
+    }
+    let boundary: Vec<(u32, u32)> = counted.iter().filter(|(_, u)| *u == 1).map(|(e, _)| *e).collect();
+    let mut degree = vec![0u8; vertices];
+    let mut loops = UnionFind::new(vertices);
+    for &(a, b) in &boundary {
+        degree[a as usize] += 1;
+        degree[b as usize] += 1;
+        loops.union(a, b);
+    }
+    // Per piece (by root): V - E + F, and a boundary loop seen (u32::MAX: none; u32::MAX - 1: two).
+    let mut euler = vec![0i64; vertices];
+    let mut in_tris = vec![false; vertices];
+    for t in tris {
+        euler[pieces.find(t[0]) as usize] += 1;
+        for &v in t {
+            if !std::mem::replace(&mut in_tris[v as usize], true) {
+                euler[pieces.find(v) as usize] += 1;
+            }
+        }
+    }
+    for ((a, _), _) in &counted {
+        euler[pieces.find(*a) as usize] -= 1;
+    }
+    let mut loop_of = vec![u32::MAX; vertices];
+    for v in 0..vertices as u32 {
+        if !in_tris[v as usize] {
+            continue;
+        }
+        match degree[v as usize] {
+            0 => {}
+            2 => {
+                let (piece, l) = (pieces.find(v) as usize, loops.find(v));
+                if loop_of[piece] == u32::MAX {
+                    loop_of[piece] = l;
+                } else if loop_of[piece] != l {
+                    return None;
+                }
+            }
+            _ => return None,
+        }
+    }
+    for v in 0..vertices {
+        if in_tris[v] && pieces.find(v as u32) as usize == v && (euler[v] != 1 || loop_of[v] == u32::MAX) {
+            return None;
+        }
+    }
+    Some(boundary)
+}
+
+struct UnionFind {
+    parent: Vec<u32>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> UnionFind {
+        UnionFind { parent: (0..n as u32).collect() }
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let up = self.parent[self.parent[x as usize] as usize];
+            self.parent[x as usize] = up;
+            x = up;
+        }
+        x
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.parent[ra as usize] = rb;
+        }
+    }
+}
