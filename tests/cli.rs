@@ -230,7 +230,7 @@ fn dmc_reports_its_octree_and_phases() {
     assert!(s["octree_leaves"].as_u64().unwrap() > 0 && s["dual_cells"].as_u64().unwrap() > 0, "{s}");
     // serde_json's map sorts keys here; the order the phases ran in is the JSON text's.
     let phases: Vec<&String> = s["phases_ms"].as_object().unwrap().keys().collect();
-    assert_eq!(phases, ["contouring", "feature_isolation", "octree", "topology"]);
+    assert_eq!(phases, ["contouring", "feature_isolation", "octree", "topology", "untangling"]);
     assert!(s["points_evaluated"].is_null(), "an EMC key, kept and null");
     let loose = stats(&["mesh", "--scene", "torus", "--method", "dmc", "--tol", "0.02", "--max-depth", "5"]);
     assert!(loose["triangles"].as_u64() < s["triangles"].as_u64(), "a looser tolerance simplifies more");

@@ -83,7 +83,8 @@ fn simplification_keeps_the_finest_levels_topology_on_every_scene() {
 }
 
 /// The rounded room (walls half a cell thick at depth 6, one cell at depth 7): one
-/// closed surface of genus 0, within 1 % of the room, where MC on the same grid loses the walls.
+/// closed surface of genus 0, within 1 % of the room, where MC on the grid of depth 6 loses the
+/// walls (at depth 7 it keeps them).
 #[test]
 fn thin_room_keeps_its_walls_where_mc_at_the_same_depth_loses_them() {
     let scene = scenes::scene("thin_room").unwrap();
@@ -98,14 +99,14 @@ fn thin_room_keeps_its_walls_where_mc_at_the_same_depth_loses_them() {
         eprintln!("thin_room depth {depth}: {} triangles, max distance {:.4}", mesh.triangle_count(), error.dist_max);
         assert!(error.dist_max < 0.01 * room, "depth {depth}: max distance {} against 1% of the room", error.dist_max);
 
-        let grid = Grid::with_resolution(scene.min, scene.max, 1 << depth).unwrap();
-        let (mc_mesh, _) = mc::mesh_field(field, &grid, &McOptions::default()).unwrap();
-        let mc_topo = analysis::topology(&mc_mesh);
-        assert!(
-            mc_topo.euler != 2 || mc_topo.components != 1 || !mc_topo.is_closed_manifold(),
-            "MC at depth {depth} was expected to lose walls: {mc_topo:?}"
-        );
     }
+    let grid = Grid::with_resolution(scene.min, scene.max, 64).unwrap();
+    let (mc_mesh, _) = mc::mesh_field(field, &grid, &McOptions::default()).unwrap();
+    let mc_topo = analysis::topology(&mc_mesh);
+    assert!(
+        mc_topo.euler != 2 || mc_topo.components != 1 || !mc_topo.is_closed_manifold(),
+        "MC at 64 cells was expected to lose walls: {mc_topo:?}"
+    );
 }
 
 /// A room the tests make up: a box of random proportions whose walls are `1/100` to `1/1000` of

@@ -100,9 +100,7 @@ pub fn sample(
                     let l = [c[0] * k + dx, c[1] * k + dy, c[2] * k + dz];
                     let key = super::dual::point_key(l);
                     let id = *index.entry(key).or_insert_with(|| {
-                        points.push(
-                            tree.origin + Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) * spacing,
-                        );
+                        points.push(tree.lattice(Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) / k as f32));
                         points.len() as u32 - 1
                     });
                     cell_samples.push(id);

@@ -12,13 +12,12 @@
 //!   point and leaves the polygon's other triangles intact.
 //! - The crossing is found by root finding on the field along the dual edge, from its inside end to
 //!   its outside end (so the result does not depend on which cell asked first), kept at least
-//!   [`crate::mc::MIN_EDGE_FRACTION`] of the edge from both ends. Root finding puts every mesh vertex
-//!   on the true surface; linear interpolation of the two values would be exact only for fields
-//!   linear along the edge.
+//!   [`crate::mc::MIN_EDGE_FRACTION`] of the edge from both ends, every edge at once
+//!   ([`batch_roots`]). Root finding puts every mesh vertex on the true surface; linear
+//!   interpolation of the two values would be exact only for fields linear along the edge.
 
 use super::dual::VertexKey;
 use super::tree::{Kind, Octree};
-use crate::emc::edges::edge_root;
 use crate::field::Field;
 use crate::mesh::Mesh;
 use crate::tables::{triangle_table, CENTER, EDGES};
@@ -93,8 +92,22 @@ pub struct Contour {
     pub cell_of_triangle: Vec<u32>,
 }
 
+/// Crossings found before, by the positions of their ends (inside first), so that contouring
+/// again after a few vertices moved root-finds only the dual edges that changed.
+pub type RootCache = HashMap<[u32; 6], f32>;
+
+fn cache_key(a: Vec3, b: Vec3) -> [u32; 6] {
+    [a.x, a.y, a.z, b.x, b.y, b.z].map(f32::to_bits)
+}
+
 /// Contours dual cells given as eight dual vertex ids each (octant order).
-pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, iso: f32) -> Contour {
+pub fn contour(
+    cells: &[[u32; 8]],
+    vertices: &DualVertices,
+    field: &dyn Field,
+    iso: f32,
+    cache: &mut RootCache,
+) -> Contour {
     let table = triangle_table();
     let mut out = Contour::default();
     let mut edges: HashMap<(u32, u32), u32> = HashMap::default();
@@ -116,13 +129,8 @@ pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, i
                     let [a, b] = EDGES[e].map(|corner| ids[corner as usize]);
                     let (inside, outside) = if vertices.inside[a as usize] { (a, b) } else { (b, a) };
                     local[e] = *edges.entry((inside, outside)).or_insert_with(|| {
-                        let (pa, pb) =
-                            (vertices.positions[inside as usize], vertices.positions[outside as usize]);
-                        let (va, vb) = (vertices.values[inside as usize], vertices.values[outside as usize]);
-                        let t = edge_root(field, iso, pa, pb, va, vb);
-                        out.crossings.push(Crossing { inside, outside, t });
-                        out.mesh.positions.push(pa + (pb - pa) * t);
-                        out.mesh.positions.len() as u32 - 1
+                        out.crossings.push(Crossing { inside, outside, t: f32::NAN });
+                        out.crossings.len() as u32 - 1
                     });
                 }
                 local[e]
@@ -133,7 +141,112 @@ pub fn contour(cells: &[[u32; 8]], vertices: &DualVertices, field: &dyn Field, i
             }
         }
     }
+    let ends = |c: &Crossing| (vertices.positions[c.inside as usize], vertices.positions[c.outside as usize]);
+    let missing: Vec<usize> = (0..out.crossings.len())
+        .filter(|&i| {
+            let (a, b) = ends(&out.crossings[i]);
+            match cache.get(&cache_key(a, b)) {
+                Some(&t) => {
+                    out.crossings[i].t = t;
+                    false
+                }
+                None => true,
+            }
+        })
+        .collect();
+    let segments: Vec<Segment> = missing
+        .iter()
+        .map(|&i| {
+            let c = out.crossings[i];
+            let (a, b) = ends(&c);
+            Segment { inside: a, outside: b, f_inside: vertices.values[c.inside as usize], f_outside: vertices.values[c.outside as usize] }
+        })
+        .collect();
+    for (&i, t) in missing.iter().zip(batch_roots(field, iso, &segments)) {
+        out.crossings[i].t = t;
+        let (a, b) = ends(&out.crossings[i]);
+        cache.insert(cache_key(a, b), t);
+    }
+    out.mesh.positions = out
+        .crossings
+        .iter()
+        .map(|c| {
+            let (a, b) = ends(c);
+            a + (b - a) * c.t
+        })
+        .collect();
     out
+}
+
+/// A dual edge to root-find on: its ends and `f - iso` there (below 0 at the inside end).
+#[derive(Debug, Clone, Copy)]
+pub struct Segment {
+    pub inside: Vec3,
+    pub outside: Vec3,
+    pub f_inside: f32,
+    pub f_outside: f32,
+}
+
+/// Regula falsi steps: Illinois' modification keeps the bracket shrinking from both sides, so
+/// this many steps reach `f32` resolution on smooth edges and a small fraction of the edge at a
+/// kink (the bracket always holds the root).
+const ROOT_STEPS: usize = 16;
+
+/// Roots of `f - iso` on many segments at once, as fractions of the way from the inside end,
+/// kept [`crate::mc::MIN_EDGE_FRACTION`] from both ends: one batch of field values per step, the
+/// way the field evaluates fastest.
+pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment]) -> Vec<f32> {
+    let n = segments.len();
+    let (mut lo, mut hi) = (vec![0.0f32; n], vec![1.0f32; n]);
+    let mut flo: Vec<f32> = segments.iter().map(|s| s.f_inside.min(-f32::MIN_POSITIVE)).collect();
+    let mut fhi: Vec<f32> = segments.iter().map(|s| s.f_outside.max(0.0)).collect();
+    let mut side = vec![0i8; n];
+    let mut t = vec![0.5f32; n];
+    let mut done = vec![false; n];
+    let mut at = Vec::with_capacity(n);
+    let mut which = Vec::with_capacity(n);
+    let mut values = Vec::with_capacity(n);
+    for _ in 0..ROOT_STEPS {
+        at.clear();
+        which.clear();
+        for i in (0..n).filter(|&i| !done[i]) {
+            let d = flo[i] - fhi[i];
+            let guess = if d < 0.0 && d.is_finite() { lo[i] + (hi[i] - lo[i]) * (flo[i] / d) } else { 0.5 * (lo[i] + hi[i]) };
+            t[i] = guess.clamp(lo[i], hi[i]);
+            let s = &segments[i];
+            at.push(s.inside + (s.outside - s.inside) * t[i]);
+            which.push(i);
+        }
+        if which.is_empty() {
+            break;
+        }
+        values.clear();
+        values.resize(at.len(), 0.0);
+        field.values(&at, &mut values);
+        for (&i, &v) in which.iter().zip(&values) {
+            let v = v - iso;
+            if v == 0.0 || hi[i] - lo[i] < 1e-6 {
+                done[i] = true;
+            }
+            if v < 0.0 {
+                lo[i] = t[i];
+                flo[i] = v;
+                if side[i] == -1 {
+                    fhi[i] *= 0.5;
+                }
+                side[i] = -1;
+            } else {
+                hi[i] = t[i];
+                fhi[i] = v;
+                if side[i] == 1 {
+                    flo[i] *= 0.5;
+                }
+                side[i] = 1;
+            }
+        }
+    }
+    let m = crate::mc::MIN_EDGE_FRACTION;
+    t.iter().map(|&t| t.clamp(m, 1.0 - m)).collect()
 }
 
 /// Unit normals from the field's gradient (central differences where it has none).

@@ -13,14 +13,10 @@
 use super::dual::VertexKey;
 use super::safety::EdgeTriangle;
 use super::tree::{Kind, Octree};
-use crate::emc::edges::edge_root;
+use super::contour::{batch_roots, Segment};
 use crate::field::{gradients_or_differences, Field};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
-
-/// Regula falsi steps per crossing: the estimate only has to be good to a small fraction of the
-/// tolerance, and Illinois converges superlinearly on the smooth stretches the crossings lie on.
-const ROOT_STEPS: usize = 8;
 
 pub struct Fidelity<'a> {
     pub field: &'a dyn Field,
@@ -37,15 +33,14 @@ impl<'a> Fidelity<'a> {
         Fidelity { field, iso, tolerance, crossings: HashMap::default(), values: HashMap::default(), points: Vec::new() }
     }
 
-    /// Whether every triangle of `tris` lies within the tolerance (the merged node's vertex is
-    /// already written into the tree).
-    pub fn within(&mut self, tree: &Octree, tris: &[EdgeTriangle]) -> bool {
-        if tris.is_empty() {
-            return true;
-        }
-        self.find_crossings(tree, tris);
+    /// Per star (the triangles a merge would make, with the merged nodes' vertices already
+    /// written into the tree), whether every triangle lies within the tolerance; all stars'
+    /// crossings and sample points are found and evaluated in one batch each.
+    pub fn within(&mut self, tree: &Octree, stars: &[Vec<EdgeTriangle>]) -> Vec<bool> {
+        let all: Vec<EdgeTriangle> = stars.iter().flatten().copied().collect();
+        self.find_crossings(tree, &all);
         self.points.clear();
-        for t in tris {
+        for t in &all {
             let [a, b, c] = t.map(|e| self.crossings[&e]);
             self.points.extend([(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]);
         }
@@ -53,96 +48,42 @@ impl<'a> Fidelity<'a> {
         self.field.values(&self.points, &mut values);
         let (mut scratch, mut gradients) = (Vec::new(), Vec::new());
         gradients_or_differences(self.field, &self.points, tree.h * 1e-2, &mut scratch, &mut gradients);
-        values.iter().zip(&gradients).all(|(&v, g)| {
-            let d = (v - self.iso).abs();
-            let len = g.length();
-            d <= self.tolerance * if len > 1e-12 { len } else { 1.0 }
-        })
+        let close: Vec<bool> = values
+            .iter()
+            .zip(&gradients)
+            .map(|(&v, g)| {
+                let len = g.length();
+                (v - self.iso).abs() <= self.tolerance * if len > 1e-12 { len } else { 1.0 }
+            })
+            .collect();
+        let mut start = 0;
+        stars
+            .iter()
+            .map(|star| {
+                let points = 4 * star.len();
+                let ok = close[start..start + points].iter().all(|&c| c);
+                start += points;
+                ok
+            })
+            .collect()
     }
 
-    /// Root-finds the crossings of `tris` not known yet, all edges at once: regula falsi with the
-    /// Illinois modification, one batch of values per step (the field's batches are what is fast).
+    /// Root-finds the crossings of `tris` not known yet, all at once.
     fn find_crossings(&mut self, tree: &Octree, tris: &[EdgeTriangle]) {
-        let mut edges: Vec<(VertexKey, VertexKey)> = Vec::new();
-        for t in tris {
-            for &e in t {
-                if !self.crossings.contains_key(&e) && !edges.contains(&e) {
-                    edges.push(e);
-                }
-            }
+        let mut edges: Vec<(VertexKey, VertexKey)> =
+            tris.iter().flatten().copied().filter(|e| !self.crossings.contains_key(e)).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let segments: Vec<Segment> = edges
+            .iter()
+            .map(|&(a, b)| {
+                let ((pa, fa), (pb, fb)) = (self.vertex(tree, a), self.vertex(tree, b));
+                Segment { inside: pa, outside: pb, f_inside: fa, f_outside: fb }
+            })
+            .collect();
+        for ((e, s), t) in edges.into_iter().zip(&segments).zip(batch_roots(self.field, self.iso, &segments)) {
+            self.crossings.insert(e, s.inside + (s.outside - s.inside) * t);
         }
-        if edges.is_empty() {
-            return;
-        }
-        // Per edge: inside end, outside end, values there (f - iso: < 0 at the inside end), bracket.
-        let ends: Vec<(Vec3, Vec3)> =
-            edges.iter().map(|&(a, b)| (self.vertex(tree, a).0, self.vertex(tree, b).0)).collect();
-        let mut lo = vec![0.0f32; edges.len()];
-        let mut hi = vec![1.0f32; edges.len()];
-        let mut flo: Vec<f32> = edges.iter().map(|&(a, _)| self.vertex(tree, a).1.min(-f32::MIN_POSITIVE)).collect();
-        let mut fhi: Vec<f32> = edges.iter().map(|&(_, b)| self.vertex(tree, b).1.max(0.0)).collect();
-        let mut side = vec![0i8; edges.len()];
-        let mut t = vec![0.5f32; edges.len()];
-        let mut at = vec![Vec3::ZERO; edges.len()];
-        let mut values = vec![0.0f32; edges.len()];
-        for _ in 0..ROOT_STEPS {
-            for i in 0..edges.len() {
-                let d = flo[i] - fhi[i];
-                t[i] = if d < 0.0 { lo[i] + (hi[i] - lo[i]) * (flo[i] / d) } else { 0.5 * (lo[i] + hi[i]) };
-                t[i] = t[i].clamp(lo[i], hi[i]);
-                at[i] = ends[i].0 + (ends[i].1 - ends[i].0) * t[i];
-            }
-            self.field.values(&at, &mut values);
-            for i in 0..edges.len() {
-                let v = values[i] - self.iso;
-                if v < 0.0 {
-                    lo[i] = t[i];
-                    flo[i] = v;
-                    if side[i] == -1 {
-                        fhi[i] *= 0.5;
-                    }
-                    side[i] = -1;
-                } else {
-                    hi[i] = t[i];
-                    fhi[i] = v;
-                    if side[i] == 1 {
-                        flo[i] *= 0.5;
-                    }
-                    side[i] = 1;
-                }
-            }
-        }
-        for (i, e) in edges.into_iter().enumerate() {
-            self.crossings.insert(e, at[i]);
-        }
-    }
-
-    /// The largest estimated distance and where (debugging).
-    pub fn worst(&mut self, tree: &Octree, tris: &[EdgeTriangle]) -> (f32, Vec3) {
-        let mut best = (0.0, Vec3::ZERO);
-        for t in tris {
-            let [a, b, c] = t.map(|e| self.crossing(tree, e));
-            for p in [(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5] {
-                let g = crate::field::gradient_or_differences(self.field, p, tree.h * 1e-2);
-                let d = (self.field.value(p) - self.iso).abs() / g.length().max(1e-12);
-                if d > best.0 {
-                    best = (d, p);
-                }
-            }
-        }
-        best
-    }
-
-    fn crossing(&mut self, tree: &Octree, edge: (VertexKey, VertexKey)) -> Vec3 {
-        if let Some(&p) = self.crossings.get(&edge) {
-            return p;
-        }
-        let (pa, va) = self.vertex(tree, edge.0);
-        let (pb, vb) = self.vertex(tree, edge.1);
-        let t = edge_root(self.field, self.iso, pa, pb, va, vb);
-        let p = pa + (pb - pa) * t;
-        self.crossings.insert(edge, p);
-        p
     }
 
     /// A dual vertex's position and `f - iso`, evaluated where only its sign was known.

@@ -132,17 +132,21 @@ pub struct DmcStats {
     pub crust_ms: f64,
     pub sampling_ms: f64,
     pub simplify_ms: f64,
+    pub dual_ms: f64,
     pub contour_ms: f64,
     pub untangle_ms: f64,
 }
 
 impl DmcStats {
-    /// The phases by name, in pipeline order, for [`crate::stats::Stats`].
+    /// The phases by name, in pipeline order, for [`crate::stats::Stats`]. The names are the ones
+    /// DMC has always reported: `octree` is the crust and the simplification, `feature_isolation`
+    /// the sampling and the vertices' placement, `topology` listing the dual cells; `untangling`
+    /// is new.
     pub fn phases(&self) -> Vec<(String, f64)> {
         vec![
-            ("crust".to_string(), self.crust_ms),
-            ("sampling".to_string(), self.sampling_ms),
-            ("simplification".to_string(), self.simplify_ms),
+            ("octree".to_string(), self.crust_ms + self.simplify_ms),
+            ("feature_isolation".to_string(), self.sampling_ms),
+            ("topology".to_string(), self.dual_ms),
             ("contouring".to_string(), self.contour_ms),
             ("untangling".to_string(), self.untangle_ms),
         ]
@@ -150,11 +154,17 @@ impl DmcStats {
 }
 
 /// Marching Cubes on the dual cells given by their keys.
-fn contour_cells(tree: &Octree, keys: &[[dual::VertexKey; 8]], field: &dyn Field, iso: f32) -> contour::Contour {
+fn contour_cells(
+    tree: &Octree,
+    keys: &[[dual::VertexKey; 8]],
+    field: &dyn Field,
+    iso: f32,
+    cache: &mut contour::RootCache,
+) -> contour::Contour {
     let mut vertices = DualVertices::default();
     let cells: Vec<[u32; 8]> = keys.iter().map(|cell| cell.map(|k| vertices.id(tree, k))).collect();
     vertices.evaluate(field, iso);
-    contour::contour(&cells, &vertices, field, iso)
+    contour::contour(&cells, &vertices, field, iso, cache)
 }
 
 /// The finest grid of a DMC run over `[min, max]`: `2^max_depth` cubic cells along the longest
@@ -163,8 +173,9 @@ pub fn finest_grid(min: glam::Vec3, max: glam::Vec3, max_depth: u8) -> Result<Gr
     Grid::with_resolution(min, max, 1usize << max_depth)
 }
 
-/// Meshes the `iso` level of `field` inside the box `[min, max]` (grown to whole finest cells, as
-/// Marching Cubes' grid is).
+/// Meshes the `iso` level of `field` inside the box `[min, max]`: the octree's finest cells are
+/// cubes, `2^max_depth` of them along the longest side, and the bounds cut the last ones along the
+/// shorter sides (nothing is sampled outside the bounds).
 pub fn mesh_field(
     field: &dyn Field,
     min: glam::Vec3,
@@ -172,18 +183,19 @@ pub fn mesh_field(
     options: &DmcOptions,
 ) -> Result<(Mesh, DmcStats), Error> {
     options.validate()?;
-    let grid = finest_grid(min, max, options.max_depth)?;
-    let clipped = bounds::Clipped { field, iso: options.iso, min: grid.origin, max: grid.max() };
+    // The bounds' checks (finite, ordered, not degenerate) and the finest cells' size.
+    finest_grid(min, max, options.max_depth)?;
+    let clipped = bounds::Clipped { field, iso: options.iso, min, max };
     let field: &dyn Field = &clipped;
     let iso = options.iso;
     let mut stats = DmcStats::default();
 
     let t = Instant::now();
-    let mut tree = Octree::new(&grid, options.max_depth);
+    let mut tree = Octree::new(min, max, options.max_depth);
     let mut built = build::crust(&mut tree, field, iso, options.samples_per_cell, options.max_cells)?;
     stats.crust_ms = ms_since(t);
 
-    let longest = (grid.max() - grid.origin).max_element();
+    let longest = (max - min).max_element();
     let tolerance = options.tolerance * longest;
     let t = Instant::now();
     build::sample(&mut tree, &clipped, iso, options.samples_per_cell, &mut built);
@@ -204,9 +216,12 @@ pub fn mesh_field(
     let mut keys = Vec::new();
     dual::for_each_mixed_cell(&tree, |cell| keys.push(*cell));
     stats.dual_cells = keys.len();
+    stats.dual_ms = ms_since(t);
+    let t = Instant::now();
     let mut moves = vec![0u8; tree.nodes.len()];
     let mut origins = rustc_hash::FxHashMap::default();
-    let mut contour = contour_cells(&tree, &keys, field, iso);
+    let mut roots = contour::RootCache::default();
+    let mut contour = contour_cells(&tree, &keys, field, iso, &mut roots);
     stats.contour_ms = ms_since(t);
     let t = Instant::now();
     for round in 0..=untangle::ROUNDS {
@@ -229,7 +244,7 @@ pub fn mesh_field(
             dual::for_each_mixed_cell(&tree, |cell| keys.push(*cell));
             stats.dual_cells = keys.len();
         }
-        contour = contour_cells(&tree, &keys, field, iso);
+        contour = contour_cells(&tree, &keys, field, iso, &mut roots);
     }
     let mut mesh = contour.mesh;
     contour::field_normals(&mut mesh, field, tree.h * 1e-2);

@@ -28,6 +28,35 @@ pub struct SimplifyStats {
     pub fidelity_ms: f64,
 }
 
+/// Makes internal node `n` a leaf: empty if its children all were, on one side, else a surface
+/// leaf with `qef`, vertex `vertex` and value `value`.
+fn merge(tree: &mut Octree, n: u32, qef: Option<Qef>, vertex: Vec3, value: f32) {
+    let first = tree.nodes[n as usize].children;
+    let uniform = (first..first + 8)
+        .map(|c| tree.nodes[c as usize].kind)
+        .filter(|k| *k != Kind::Absent)
+        .try_fold(None, |seen, k| match (seen, k) {
+            (_, Kind::Empty { inside }) if seen.is_none() || seen == Some(inside) => Ok(Some(inside)),
+            _ => Err(()),
+        });
+    let node = &mut tree.nodes[n as usize];
+    match uniform {
+        Ok(Some(inside)) => {
+            node.kind = Kind::Empty { inside };
+            node.value = if inside { -f32::MIN_POSITIVE } else { f32::MIN_POSITIVE };
+        }
+        _ => {
+            node.kind = Kind::Surface;
+            node.value = value;
+        }
+    }
+    node.vertex = vertex;
+    if let Some(q) = qef {
+        node.qef = tree.qefs.len() as u32;
+        tree.qefs.push(q);
+    }
+}
+
 /// Merges bottom-up; `tolerance` (world units) bounds both the root-mean-square 4-D distance of a
 /// leaf's sampled tangent planes from its vertex and the distance of the triangles a merge makes
 /// from the surface ([`super::fidelity`]).
@@ -71,9 +100,6 @@ pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) 
             }
             candidates.push((n, qef, vertex, free));
         }
-        if std::env::var_os("ISOFORGE_DMC_DEBUG").is_some() {
-            eprintln!("level {level}: {} internal, {} candidates, so far {stats:?}", by_level[level].len(), candidates.len());
-        }
         if candidates.is_empty() {
             continue;
         }
@@ -87,64 +113,49 @@ pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) 
             .collect();
         let free: Vec<bool> = candidates.iter().map(|c| c.3).collect();
         let values = super::build::settle_vertices(field, iso, &mut points, &centres, &free, tree.h);
-        for (((n, qef, _, _), vertex), value) in candidates.into_iter().zip(points).zip(values) {
-            // The candidate vertex, read by the tests below through the (still internal) node.
-            tree.nodes[n as usize].vertex = vertex;
-            tree.nodes[n as usize].value = value;
+        // The candidates in eight classes by the parity of their position: two of one class are a
+        // node apart, so no dual cell has leaves of both and their tests do not depend on each
+        // other. Each class is tested against the merges of the classes before it, all at once.
+        let side = 1u32 << (tree.depth as usize - level);
+        let class = |n: u32| {
+            let c = tree.nodes[n as usize].coord;
+            (0..3).fold(0usize, |k, a| k | ((((c[a] / side) & 1) as usize) << a))
+        };
+        let mut classes: [Vec<usize>; 8] = Default::default();
+        for (i, c) in candidates.iter().enumerate() {
+            classes[class(c.0)].push(i);
+        }
+        for members in &classes {
+            let mut safe = Vec::new();
+            let mut stars = Vec::new();
+            for &i in members {
+                let n = candidates[i].0;
+                // The candidate vertex, read by the tests through the (still internal) node.
+                tree.nodes[n as usize].vertex = points[i];
+                tree.nodes[n as usize].value = values[i];
+                let t0 = web_time::Instant::now();
+                let star = merge_is_safe(tree, n, values[i]);
+                stats.safety_ms += crate::mc::ms_since(t0);
+                match star {
+                    Some(star) => {
+                        safe.push(i);
+                        stars.push(star);
+                    }
+                    None => stats.unsafe_merges += 1,
+                }
+            }
             let t0 = web_time::Instant::now();
-            let safe = merge_is_safe(tree, n, value);
-            stats.safety_ms += crate::mc::ms_since(t0);
-            let Some(star) = safe else {
-                stats.unsafe_merges += 1;
-                continue;
-            };
-            let t0 = web_time::Instant::now();
-            let within = fidelity.within(tree, &star);
+            let within = fidelity.within(tree, &stars);
             stats.fidelity_ms += crate::mc::ms_since(t0);
-            if !within {
-                if std::env::var_os("ISOFORGE_DMC_DEBUG").is_some() {
-                    let (lo, hi) = tree.world_box(n);
-                    eprintln!("inaccurate {level} {:?} {:?}", (lo + hi) * 0.5, fidelity.worst(tree, &star));
+            for (&i, ok) in safe.iter().zip(within) {
+                if !ok {
+                    stats.inaccurate_merges += 1;
+                    continue;
                 }
-                stats.inaccurate_merges += 1;
-                continue;
-            }
-            stats.merged += 1;
-            let first = tree.nodes[n as usize].children;
-            let uniform = (first..first + 8)
-                .map(|c| tree.nodes[c as usize].kind)
-                .filter(|k| *k != Kind::Absent)
-                .try_fold(None, |seen, k| match (seen, k) {
-                    (_, Kind::Empty { inside }) if seen.is_none() || seen == Some(inside) => Ok(Some(inside)),
-                    _ => Err(()),
-                });
-            let node = &mut tree.nodes[n as usize];
-            match uniform {
-                Ok(Some(inside)) => {
-                    node.kind = Kind::Empty { inside };
-                    node.value = if inside { -f32::MIN_POSITIVE } else { f32::MIN_POSITIVE };
-                }
-                _ => {
-                    node.kind = Kind::Surface;
-                    node.value = value;
-                }
-            }
-            node.vertex = vertex;
-            if let Some(q) = qef {
-                node.qef = tree.qefs.len() as u32;
-                tree.qefs.push(q);
+                stats.merged += 1;
+                merge(tree, candidates[i].0, candidates[i].1.take(), points[i], values[i]);
             }
         }
-    }
-    if std::env::var_os("ISOFORGE_DMC_DEBUG").is_some() {
-        eprintln!("{stats:?}");
-        let mut hist = vec![[0usize; 3]; tree.depth as usize + 1];
-        for n in tree.leaves() {
-            let node = &tree.nodes[n as usize];
-            let k = match node.kind { Kind::Surface => 0, Kind::Empty { inside: false } => 1, _ => 2 };
-            hist[node.level as usize][k] += 1;
-        }
-        eprintln!("leaves per level [surface, empty out, empty in]: {hist:?}");
     }
     stats
 }

@@ -1,14 +1,13 @@
 //! The octree DMC adapts: a cube of `2^depth` finest cells on a side, anchored at the lowest corner
-//! of the finest grid (the grid Marching Cubes would use at that resolution, see
-//! [`crate::grid::Grid::with_resolution`]) and clipped to it. A node that lies wholly outside the
-//! grid is [`Kind::Absent`]; one that crosses the grid's far faces is the box where the two meet,
-//! so every leaf, every vertex and every sample lies inside the bounds.
+//! of the bounds, whose finest cells are cubes of the bounds' longest side over `2^depth`, clipped
+//! to the bounds: along a shorter side the last cell is cut by the bounds' face. A node that lies
+//! wholly outside the bounds is [`Kind::Absent`]; one that crosses their far faces is the box where
+//! the two meet, so every leaf, every vertex and every sample lies inside the bounds.
 //!
 //! Coordinates are integers in units of the finest cell, so a node's geometry never depends on the
 //! order nodes were built or merged in.
 
 use super::qef::Qef;
-use crate::grid::Grid;
 use glam::Vec3;
 
 pub const NONE: u32 = u32::MAX;
@@ -51,14 +50,18 @@ pub struct Octree {
     /// Finest cells along each axis: the grid the octree is clipped to.
     pub cells: [u32; 3],
     pub origin: Vec3,
+    /// The bounds' far corner: lattice points beyond it are clipped onto it.
+    pub max: Vec3,
     /// Side of a finest cell.
     pub h: f32,
 }
 
 impl Octree {
-    /// A root (internal, to be built) over `grid`, whose cells are cubes no more than
-    /// `2^depth` along any axis.
-    pub fn new(grid: &Grid, depth: u8) -> Octree {
+    /// A root (internal, to be built) over the bounds `[min, max]`.
+    pub fn new(min: Vec3, max: Vec3, depth: u8) -> Octree {
+        let h = (max - min).max_element() / (1u32 << depth) as f32;
+        // Whole cells where an extent is a whole number of them (to rounding), else one more, cut.
+        let cells = [0, 1, 2].map(|a| (((max[a] - min[a]) / h - 1e-3).ceil().max(1.0) as u32).min(1 << depth));
         let root = Node {
             coord: [0; 3],
             level: 0,
@@ -72,9 +75,10 @@ impl Octree {
             nodes: vec![root],
             qefs: Vec::new(),
             depth,
-            cells: grid.cells.map(|c| c as u32),
-            origin: grid.origin,
-            h: grid.spacing.x,
+            cells,
+            origin: min,
+            max,
+            h,
         }
     }
 
@@ -91,9 +95,17 @@ impl Octree {
         (node.coord, hi)
     }
 
-    /// World position of a lattice point given in finest cells.
+    /// World position of a lattice point given in finest cells (clipped to the bounds).
     pub fn point(&self, p: [u32; 3]) -> Vec3 {
-        self.origin + Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) * self.h
+        self.lattice(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+    }
+
+    /// World position of a point given in (fractional) finest cells, clipped to the bounds.
+    pub fn lattice(&self, p: Vec3) -> Vec3 {
+        let q = self.origin + p * self.h;
+        let last = Vec3::new(self.cells[0] as f32, self.cells[1] as f32, self.cells[2] as f32);
+        // The far faces are the bounds' own, not the lattice's.
+        Vec3::select(p.cmpge(last), self.max, q.min(self.max))
     }
 
     /// The world box of node `n` (clipped to the grid).
