@@ -12,6 +12,8 @@
 //!   tolerance and [`safety`] proves the contour's topology unchanged.
 //! - [`dual`]: the dual cells, one per octree vertex, the grid's boundary included.
 //! - [`contour`]: Marching Cubes on the dual cells, crossings by root finding per dual edge.
+//! - [`slivers`]: crossings within a tenth of a cell of a dual vertex moved onto it, the slivers
+//!   between them dropped.
 //! - [`untangle`]: vertices of folded or crossing triangles moved toward their leaves' centres,
 //!   keeping their signs (so the topology), in a bounded number of rounds.
 //!
@@ -35,6 +37,7 @@ pub mod fidelity;
 pub mod qef;
 pub mod safety;
 pub mod simplify;
+pub mod slivers;
 pub mod tree;
 pub mod untangle;
 
@@ -164,7 +167,9 @@ fn contour_cells(
     let mut vertices = DualVertices::default();
     let cells: Vec<[u32; 8]> = keys.iter().map(|cell| cell.map(|k| vertices.id(tree, k))).collect();
     vertices.evaluate(field, iso);
-    contour::contour(&cells, &vertices, field, iso, cache)
+    let mut contour = contour::contour(&cells, &vertices, field, iso, cache);
+    slivers::collapse(&mut contour, &vertices, tree.h);
+    contour
 }
 
 /// The finest grid of a DMC run over `[min, max]`: `2^max_depth` cubic cells along the longest

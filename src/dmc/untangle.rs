@@ -62,7 +62,7 @@ pub fn move_toward_centres(
     around.dedup();
     let merged = |n: u32| tree.nodes[n as usize].children != super::tree::NONE;
     let exhausted = |n: u32| moves[n as usize] as usize >= STEPS.len();
-    let unmerge: Vec<u32> = around.iter().copied().filter(|&n| merged(n) && moves[n as usize] > 0).collect();
+    let unmerge: Vec<u32> = around.iter().copied().filter(|&n| merged(n)).collect();
     for &n in &unmerge {
         tree.nodes[n as usize].kind = Kind::Internal;
     }
