@@ -28,9 +28,15 @@ fn whole_runs(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("dmc/{name}"));
         group.sample_size(10).measurement_time(Duration::from_secs(4));
         let grid = Grid::with_resolution(scene.min, scene.max, 1 << DEPTH).unwrap();
-        group.bench_function("mc", |b| b.iter(|| mc::mesh_field(field, &grid, &McOptions::default()).unwrap()));
-        group.bench_function("emc", |b| b.iter(|| emc::mesh_field(field, &grid, &EmcOptions::default()).unwrap()));
-        group.bench_function("dmc", |b| b.iter(|| dmc::mesh_field(field, scene.min, scene.max, &options).unwrap()));
+        group.bench_function("mc", |b| {
+            b.iter(|| mc::mesh_field(field, &grid, &McOptions::default()).unwrap())
+        });
+        group.bench_function("emc", |b| {
+            b.iter(|| emc::mesh_field(field, &grid, &EmcOptions::default()).unwrap())
+        });
+        group.bench_function("dmc", |b| {
+            b.iter(|| dmc::mesh_field(field, scene.min, scene.max, &options).unwrap())
+        });
         group.finish();
     }
 }

@@ -96,9 +96,16 @@ fn thin_room_keeps_its_walls_where_mc_at_the_same_depth_loses_them() {
         assert_eq!((topo.euler, topo.components), (2, 1), "depth {depth}: the door joins inside and out");
         let room = 1.6;
         let error = analysis::surface_error(&mesh, field);
-        eprintln!("thin_room depth {depth}: {} triangles, max distance {:.4}", mesh.triangle_count(), error.dist_max);
-        assert!(error.dist_max < 0.01 * room, "depth {depth}: max distance {} against 1% of the room", error.dist_max);
-
+        eprintln!(
+            "thin_room depth {depth}: {} triangles, max distance {:.4}",
+            mesh.triangle_count(),
+            error.dist_max
+        );
+        assert!(
+            error.dist_max < 0.01 * room,
+            "depth {depth}: max distance {} against 1% of the room",
+            error.dist_max
+        );
     }
     let grid = Grid::with_resolution(scene.min, scene.max, 64).unwrap();
     let (mc_mesh, _) = mc::mesh_field(field, &grid, &McOptions::default()).unwrap();
@@ -127,13 +134,8 @@ fn random_room(rng: &mut Rng) -> Room {
     let half = Vec3::new(rng.range(0.45, 0.85), rng.range(0.45, 0.85), rng.range(0.3, 0.6));
     let size = 2.0 * half.max_element();
     let thickness = size * 10f32.powf(-rng.range(2.0, 3.0));
-    let mut text = format!(
-        "room = shell(box({:.4}, {:.4}, {:.4}), {:.6});\n",
-        half.x,
-        half.y,
-        half.z,
-        thickness / 2.0
-    );
+    let mut text =
+        format!("room = shell(box({:.4}, {:.4}, {:.4}), {:.6});\n", half.x, half.y, half.z, thickness / 2.0);
     // The door: in the -y wall, above the floor.
     let (dw, dh) = (rng.range(0.1, 0.25) * half.x, rng.range(0.4, 0.7) * half.z);
     let dx = rng.range(-0.5, 0.5) * (half.x - dw);
@@ -191,7 +193,12 @@ fn generated_rooms_are_closed_with_the_right_genus_within_1_percent() {
         let topo = assert_watertight(&mesh, &what);
         assert_eq!((topo.euler, topo.components), (4 - 2 * room.openings, 1), "{what}");
         let error = analysis::surface_error(&mesh, &field);
-        eprintln!("seed {seed}: {} triangles, max distance {:.4} of {:.4}", mesh.triangle_count(), error.dist_max, room.size);
+        eprintln!(
+            "seed {seed}: {} triangles, max distance {:.4} of {:.4}",
+            mesh.triangle_count(),
+            error.dist_max,
+            room.size
+        );
         assert!(error.dist_max < 0.01 * room.size as f64, "{what}: max distance {}", error.dist_max);
     }
 }
@@ -275,9 +282,17 @@ fn rocket_keeps_its_topology_at_depth_7() {
 /// it must count as inside (`dmc::build::settle_vertices`), or the solid gets pinholes.
 #[test]
 fn a_union_sharing_a_face_has_no_pinholes() {
-    let field = expr::compile("union(translate(box(0.3, 0.4, 0.4), -0.3, 0, 0), translate(box(0.3, 0.4, 0.4), 0.3, 0, 0))").unwrap();
+    let field = expr::compile(
+        "union(translate(box(0.3, 0.4, 0.4), -0.3, 0, 0), translate(box(0.3, 0.4, 0.4), 0.3, 0, 0))",
+    )
+    .unwrap();
     for depth in [4, 5, 6] {
-        let (mesh, _) = dmc_mesh(&field, Vec3::splat(-1.0), Vec3::splat(1.0), &DmcOptions { max_depth: depth, ..DmcOptions::default() });
+        let (mesh, _) = dmc_mesh(
+            &field,
+            Vec3::splat(-1.0),
+            Vec3::splat(1.0),
+            &DmcOptions { max_depth: depth, ..DmcOptions::default() },
+        );
         let topo = assert_watertight(&mesh, "two boxes");
         assert_eq!((topo.euler, topo.components), (2, 1), "depth {depth}");
     }

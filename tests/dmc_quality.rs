@@ -30,7 +30,8 @@ struct Pairing {
     emc_res: usize,
 }
 
-const PAIRINGS: [Pairing; 1] = [Pairing { scene: "cube_minus_sphere", max_depth: 6, tolerance: 0.001, emc_res: 32 }];
+const PAIRINGS: [Pairing; 1] =
+    [Pairing { scene: "cube_minus_sphere", max_depth: 6, tolerance: 0.001, emc_res: 32 }];
 
 fn dmc_mesh(scene: &Scene, pairing: &Pairing) -> (Mesh, SurfaceError) {
     let options =

@@ -182,7 +182,8 @@ mod tests {
             let scene = crate::scenes::scene(name).unwrap();
             let field = scene.field.as_ref();
             let (min, max) = (scene.min, scene.max);
-            let grid = crate::dmc::finest_grid(min, max, crate::dmc::DmcOptions::default().max_depth).unwrap();
+            let grid =
+                crate::dmc::finest_grid(min, max, crate::dmc::DmcOptions::default().max_depth).unwrap();
             let (root, size) = (grid.origin, grid.max() - grid.origin);
             let clipped = Clipped { field, iso: 0.0, min, max };
             let n = 20;

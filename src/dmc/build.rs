@@ -13,10 +13,10 @@
 //! ([`super::qef`]); a parent's QEF is the sum of its children's, so simplification
 //! ([`super::simplify`]) samples nothing more.
 
+use super::bounds::Clipped;
 use super::qef::Qef;
 use super::tree::{Kind, Octree};
 use crate::error::Error;
-use super::bounds::Clipped;
 use crate::field::Field;
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
@@ -77,19 +77,14 @@ pub fn crust(
 
 /// Samples the crust cells, gives each its QEF and its vertex, and puts the vertices of the empty
 /// leaves at their centres. Every value is `f - iso`.
-pub fn sample(
-    tree: &mut Octree,
-    field: &Clipped,
-    iso: f32,
-    samples_per_cell: usize,
-    stats: &mut BuildStats,
-) {
+pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: usize, stats: &mut BuildStats) {
     let k = (samples_per_cell - 1) as u32;
     let spacing = tree.h / k as f32;
     let leaves = tree.leaves();
     let crust: Vec<u32> =
         leaves.iter().copied().filter(|&n| tree.nodes[n as usize].kind == Kind::Surface).collect();
-    let mut index: HashMap<u64, u32> = HashMap::with_capacity_and_hasher(crust.len() * (k as usize).pow(3) + 16, Default::default());
+    let mut index: HashMap<u64, u32> =
+        HashMap::with_capacity_and_hasher(crust.len() * (k as usize).pow(3) + 16, Default::default());
     let mut points = Vec::new();
     let mut cell_samples = Vec::with_capacity(crust.len() * (samples_per_cell).pow(3));
     for &n in &crust {
@@ -100,7 +95,8 @@ pub fn sample(
                     let l = [c[0] * k + dx, c[1] * k + dy, c[2] * k + dz];
                     let key = super::dual::point_key(l);
                     let id = *index.entry(key).or_insert_with(|| {
-                        points.push(tree.lattice(Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) / k as f32));
+                        points
+                            .push(tree.lattice(Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) / k as f32));
                         points.len() as u32 - 1
                     });
                     cell_samples.push(id);
@@ -129,10 +125,13 @@ pub fn sample(
         tree.nodes[n as usize].qef = tree.qefs.len() as u32;
         tree.qefs.push(qef);
     }
-    let centres: Vec<Vec3> = crust.iter().map(|&n| {
-        let (lo, hi) = tree.world_box(n);
-        (lo + hi) * 0.5
-    }).collect();
+    let centres: Vec<Vec3> = crust
+        .iter()
+        .map(|&n| {
+            let (lo, hi) = tree.world_box(n);
+            (lo + hi) * 0.5
+        })
+        .collect();
     let at = settle_vertices(field, iso, &mut vertices, &centres, &free, tree.h);
     for ((&n, &v), &f) in crust.iter().zip(&vertices).zip(&at) {
         let node = &mut tree.nodes[n as usize];
@@ -176,8 +175,9 @@ pub fn settle_vertices(
     let mut at = vec![0.0; vertices.len()];
     field.values(vertices, &mut at);
     let band = LEVEL_BAND * h;
-    let near: Vec<usize> =
-        (0..at.len()).filter(|&i| (at[i] - iso).abs() <= if free[i] { band } else { band * STOPPED_BAND }).collect();
+    let near: Vec<usize> = (0..at.len())
+        .filter(|&i| (at[i] - iso).abs() <= if free[i] { band } else { band * STOPPED_BAND })
+        .collect();
     let points: Vec<Vec3> = near.iter().map(|&i| centres[i]).collect();
     let mut at_centre = vec![0.0; points.len()];
     field.values(&points, &mut at_centre);

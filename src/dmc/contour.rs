@@ -159,7 +159,12 @@ pub fn contour(
         .map(|&i| {
             let c = out.crossings[i];
             let (a, b) = ends(&c);
-            Segment { inside: a, outside: b, f_inside: vertices.values[c.inside as usize], f_outside: vertices.values[c.outside as usize] }
+            Segment {
+                inside: a,
+                outside: b,
+                f_inside: vertices.values[c.inside as usize],
+                f_outside: vertices.values[c.outside as usize],
+            }
         })
         .collect();
     for (&i, t) in missing.iter().zip(batch_roots(field, iso, &segments)) {
@@ -211,7 +216,11 @@ pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment]) -> Vec<f32
         which.clear();
         for i in (0..n).filter(|&i| !done[i]) {
             let d = flo[i] - fhi[i];
-            let guess = if d < 0.0 && d.is_finite() { lo[i] + (hi[i] - lo[i]) * (flo[i] / d) } else { 0.5 * (lo[i] + hi[i]) };
+            let guess = if d < 0.0 && d.is_finite() {
+                lo[i] + (hi[i] - lo[i]) * (flo[i] / d)
+            } else {
+                0.5 * (lo[i] + hi[i])
+            };
             t[i] = guess.clamp(lo[i], hi[i]);
             let s = &segments[i];
             at.push(s.inside + (s.outside - s.inside) * t[i]);

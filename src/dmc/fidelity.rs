@@ -10,10 +10,10 @@
 //! Crossings are remembered per dual edge: a dual edge keeps its ends until one of them is merged
 //! away, after which its key names nothing reachable.
 
+use super::contour::{batch_roots, Segment};
 use super::dual::VertexKey;
 use super::safety::EdgeTriangle;
 use super::tree::{Kind, Octree};
-use super::contour::{batch_roots, Segment};
 use crate::field::{gradients_or_differences, Field};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
@@ -30,7 +30,14 @@ pub struct Fidelity<'a> {
 
 impl<'a> Fidelity<'a> {
     pub fn new(field: &'a dyn Field, iso: f32, tolerance: f32) -> Fidelity<'a> {
-        Fidelity { field, iso, tolerance, crossings: HashMap::default(), values: HashMap::default(), points: Vec::new() }
+        Fidelity {
+            field,
+            iso,
+            tolerance,
+            crossings: HashMap::default(),
+            values: HashMap::default(),
+            points: Vec::new(),
+        }
     }
 
     /// Per star (the triangles a merge would make, with the merged nodes' vertices already
@@ -81,7 +88,8 @@ impl<'a> Fidelity<'a> {
                 Segment { inside: pa, outside: pb, f_inside: fa, f_outside: fb }
             })
             .collect();
-        for ((e, s), t) in edges.into_iter().zip(&segments).zip(batch_roots(self.field, self.iso, &segments)) {
+        for ((e, s), t) in edges.into_iter().zip(&segments).zip(batch_roots(self.field, self.iso, &segments))
+        {
             self.crossings.insert(e, s.inside + (s.outside - s.inside) * t);
         }
     }

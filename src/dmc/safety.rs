@@ -44,12 +44,14 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
     push_corners(tree, n, &mut after);
     let (before, after) = (unique(before), unique(after));
     let sign_before = |k: VertexKey| dual::inside(tree, k);
-    let sign_after = |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
+    let sign_after =
+        |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
     let mut crossings = Crossings::default();
     let tris_before = star_triangles(tree, &before, NONE, &sign_before, &mut crossings);
     let tris_after = star_triangles(tree, &after, n, &sign_after, &mut crossings);
     let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
-        let mut by_id = vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
+        let mut by_id =
+            vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
         for (&e, &id) in &crossings.ids {
             by_id[id as usize] = e;
         }

@@ -91,7 +91,8 @@ pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) 
             }
             if let Some(q) = &qef {
                 let placed = place(q, lo, hi);
-                if !(placed.rms <= tolerance as f64) {
+                // A NaN residual (a degenerate QEF) refuses the merge too.
+                if placed.rms.is_nan() || placed.rms > tolerance as f64 {
                     stats.qef_refused += 1;
                     continue;
                 }

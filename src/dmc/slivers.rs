@@ -55,7 +55,8 @@ pub fn collapse(contour: &mut Contour, vertices: &DualVertices, h: f32) -> usize
     }
     let collapsed = crate::mesh::Mesh { positions, normals: Vec::new(), triangles };
     let (before, after) = (analysis::topology(&contour.mesh), analysis::topology(&collapsed));
-    let same = |t: &analysis::Topology| (t.euler, t.components, t.is_closed_manifold(), t.degenerate_triangles);
+    let same =
+        |t: &analysis::Topology| (t.euler, t.components, t.is_closed_manifold(), t.degenerate_triangles);
     if same(&before) != same(&after) {
         return 0;
     }

@@ -61,7 +61,8 @@ impl Octree {
     pub fn new(min: Vec3, max: Vec3, depth: u8) -> Octree {
         let h = (max - min).max_element() / (1u32 << depth) as f32;
         // Whole cells where an extent is a whole number of them (to rounding), else one more, cut.
-        let cells = [0, 1, 2].map(|a| (((max[a] - min[a]) / h - 1e-3).ceil().max(1.0) as u32).min(1 << depth));
+        let cells =
+            [0, 1, 2].map(|a| (((max[a] - min[a]) / h - 1e-3).ceil().max(1.0) as u32).min(1 << depth));
         let root = Node {
             coord: [0; 3],
             level: 0,
@@ -71,15 +72,7 @@ impl Octree {
             vertex: Vec3::ZERO,
             value: 0.0,
         };
-        Octree {
-            nodes: vec![root],
-            qefs: Vec::new(),
-            depth,
-            cells,
-            origin: min,
-            max,
-            h,
-        }
+        Octree { nodes: vec![root], qefs: Vec::new(), depth, cells, origin: min, max, h }
     }
 
     /// Side of node `n` in finest cells.
@@ -157,7 +150,8 @@ impl Octree {
                 return n;
             }
             let half = 1u32 << (self.depth - node.level - 1);
-            let child = |q: [u32; 3]| (0..3).fold(0, |c, a| c | ((((q[a] - node.coord[a]) >= half) as u32) << a));
+            let child =
+                |q: [u32; 3]| (0..3).fold(0, |c, a| c | ((((q[a] - node.coord[a]) >= half) as u32) << a));
             let (a, b) = (child(lo), child(hi));
             if a != b {
                 return n;

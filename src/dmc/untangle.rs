@@ -38,7 +38,8 @@ const STEPS: [f32; 3] = [0.25, 0.6, 1.0];
 
 /// Triangles that cross another or lie folded onto a neighbour.
 pub fn offending_triangles(mesh: &Mesh) -> Vec<u32> {
-    let mut out: Vec<u32> = self_intersecting_pairs(mesh).into_iter().chain(folded_pairs(mesh)).flatten().collect();
+    let mut out: Vec<u32> =
+        self_intersecting_pairs(mesh).into_iter().chain(folded_pairs(mesh)).flatten().collect();
     out.sort_unstable();
     out.dedup();
     out
