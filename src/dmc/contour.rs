@@ -167,7 +167,7 @@ pub fn contour(
             }
         })
         .collect();
-    for (&i, t) in missing.iter().zip(batch_roots(field, iso, &segments)) {
+    for (&i, t) in missing.iter().zip(batch_roots(field, iso, &segments, ROOT_STEPS)) {
         out.crossings[i].t = t;
         let (a, b) = ends(&out.crossings[i]);
         cache.insert(cache_key(a, b), t);
@@ -192,15 +192,15 @@ pub struct Segment {
     pub f_outside: f32,
 }
 
-/// Regula falsi steps: Illinois' modification keeps the bracket shrinking from both sides, so
-/// this many steps reach `f32` resolution on smooth edges and a small fraction of the edge at a
-/// kink (the bracket always holds the root).
-const ROOT_STEPS: usize = 16;
+/// Regula falsi steps for the mesh's vertices: Illinois' modification keeps the bracket shrinking
+/// from both sides, so this many steps reach `f32` resolution on smooth edges and a small fraction
+/// of the edge at a kink (the bracket always holds the root).
+pub const ROOT_STEPS: usize = 16;
 
 /// Roots of `f - iso` on many segments at once, as fractions of the way from the inside end,
 /// kept [`crate::mc::MIN_EDGE_FRACTION`] from both ends: one batch of field values per step, the
 /// way the field evaluates fastest.
-pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment]) -> Vec<f32> {
+pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment], steps: usize) -> Vec<f32> {
     let n = segments.len();
     let (mut lo, mut hi) = (vec![0.0f32; n], vec![1.0f32; n]);
     let mut flo: Vec<f32> = segments.iter().map(|s| s.f_inside.min(-f32::MIN_POSITIVE)).collect();
@@ -211,7 +211,7 @@ pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment]) -> Vec<f32
     let mut at = Vec::with_capacity(n);
     let mut which = Vec::with_capacity(n);
     let mut values = Vec::with_capacity(n);
-    for _ in 0..ROOT_STEPS {
+    for _ in 0..steps {
         at.clear();
         which.clear();
         for i in (0..n).filter(|&i| !done[i]) {

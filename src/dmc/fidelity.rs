@@ -18,6 +18,13 @@ use crate::field::{gradients_or_differences, Field};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
 
+/// A dual edge, by its ends (inside first): the name of the crossing on it.
+type DualEdge = (VertexKey, VertexKey);
+
+/// Regula falsi steps for the crossings the test estimates distances from: a distance estimate
+/// needs them good to a small fraction of the tolerance, not to `f32` resolution.
+const ROOT_STEPS: usize = 8;
+
 pub struct Fidelity<'a> {
     pub field: &'a dyn Field,
     pub iso: f32,
@@ -46,10 +53,26 @@ impl<'a> Fidelity<'a> {
     pub fn within(&mut self, tree: &Octree, stars: &[Vec<EdgeTriangle>]) -> Vec<bool> {
         let all: Vec<EdgeTriangle> = stars.iter().flatten().copied().collect();
         self.find_crossings(tree, &all);
+        // Per triangle its centroid and its edges' midpoints, each midpoint evaluated once.
         self.points.clear();
+        let mut midpoints: HashMap<(DualEdge, DualEdge), u32> = HashMap::default();
+        let mut samples: Vec<[u32; 4]> = Vec::with_capacity(all.len());
         for t in &all {
             let [a, b, c] = t.map(|e| self.crossings[&e]);
-            self.points.extend([(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]);
+            let centroid = self.points.len() as u32;
+            self.points.push((a + b + c) / 3.0);
+            let mut ids = [centroid; 4];
+            for (k, (i, j)) in [(0, 1), (1, 2), (2, 0)].into_iter().enumerate() {
+                let key = (t[i].min(t[j]), t[i].max(t[j]));
+                let (p, q) = (self.crossings[&t[i]], self.crossings[&t[j]]);
+                let next = self.points.len() as u32;
+                let id = *midpoints.entry(key).or_insert(next);
+                if id == next {
+                    self.points.push((p + q) * 0.5);
+                }
+                ids[k + 1] = id;
+            }
+            samples.push(ids);
         }
         let mut values = vec![0.0; self.points.len()];
         self.field.values(&self.points, &mut values);
@@ -67,9 +90,8 @@ impl<'a> Fidelity<'a> {
         stars
             .iter()
             .map(|star| {
-                let points = 4 * star.len();
-                let ok = close[start..start + points].iter().all(|&c| c);
-                start += points;
+                let ok = samples[start..start + star.len()].iter().flatten().all(|&p| close[p as usize]);
+                start += star.len();
                 ok
             })
             .collect()
@@ -88,7 +110,8 @@ impl<'a> Fidelity<'a> {
                 Segment { inside: pa, outside: pb, f_inside: fa, f_outside: fb }
             })
             .collect();
-        for ((e, s), t) in edges.into_iter().zip(&segments).zip(batch_roots(self.field, self.iso, &segments))
+        for ((e, s), t) in
+            edges.into_iter().zip(&segments).zip(batch_roots(self.field, self.iso, &segments, ROOT_STEPS))
         {
             self.crossings.insert(e, s.inside + (s.outside - s.inside) * t);
         }
