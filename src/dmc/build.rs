@@ -28,7 +28,6 @@ pub const MARGIN: f32 = 1e-3;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BuildStats {
     pub crust_cells: usize,
-    pub interval_queries: usize,
     pub samples: usize,
 }
 
@@ -47,7 +46,6 @@ pub fn crust(
     let mut stack = vec![0u32];
     while let Some(n) = stack.pop() {
         let (lo, hi) = tree.world_box(n);
-        stats.interval_queries += 1;
         if let Some((a, b)) = field.interval(lo, hi) {
             if a > iso || b < iso {
                 tree.nodes[n as usize].kind = Kind::Empty { inside: b < iso };
@@ -110,8 +108,10 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
     let per_cell = samples_per_cell.pow(3);
     let mut vertices = Vec::with_capacity(crust.len());
     let mut free = Vec::with_capacity(crust.len());
+    let mut centres = Vec::with_capacity(crust.len());
     for (i, &n) in crust.iter().enumerate() {
         let (lo, hi) = tree.world_box(n);
+        centres.push((lo + hi) * 0.5);
         let mut qef = Qef::new((lo + hi) * 0.5);
         for &s in &cell_samples[i * per_cell..(i + 1) * per_cell] {
             let (v, g) = (values[s as usize], gradients[s as usize]);
@@ -125,13 +125,6 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
         tree.nodes[n as usize].qef = tree.qefs.len() as u32;
         tree.qefs.push(qef);
     }
-    let centres: Vec<Vec3> = crust
-        .iter()
-        .map(|&n| {
-            let (lo, hi) = tree.world_box(n);
-            (lo + hi) * 0.5
-        })
-        .collect();
     let at = settle_vertices(field, iso, &mut vertices, &centres, &free, tree.h);
     for ((&n, &v), &f) in crust.iter().zip(&vertices).zip(&at) {
         let node = &mut tree.nodes[n as usize];
@@ -143,8 +136,7 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
             let (lo, hi) = tree.world_box(n);
             let node = &mut tree.nodes[n as usize];
             node.vertex = (lo + hi) * 0.5;
-            // The sign is proven by the bound; the value is found only if a crossing needs it.
-            node.value = if inside { -f32::MIN_POSITIVE } else { f32::MIN_POSITIVE };
+            node.value = super::dual::side_only(inside);
         }
     }
 }

@@ -16,7 +16,7 @@
 //!   ([`batch_roots`]). Root finding puts every mesh vertex on the true surface; linear
 //!   interpolation of the two values would be exact only for fields linear along the edge.
 
-use super::dual::VertexKey;
+use super::dual::{on_side, VertexKey};
 use super::tree::{Kind, Octree};
 use crate::field::Field;
 use crate::mesh::Mesh;
@@ -61,14 +61,8 @@ impl DualVertices {
         let mut values = vec![0.0; points.len()];
         field.values(&points, &mut values);
         for (&i, v) in self.unknown.iter().zip(values) {
-            // Keep the side the bound proved (a value at the level counts as outside).
-            let inside = self.inside[i as usize];
-            let v = v - iso;
-            self.values[i as usize] = match inside {
-                true if v < 0.0 => v,
-                true => -f32::MIN_POSITIVE,
-                false => v.max(0.0),
-            };
+            // Keep the side the bound proved.
+            self.values[i as usize] = super::dual::on_side(v - iso, self.inside[i as usize]);
         }
         self.unknown.clear();
     }
@@ -203,8 +197,8 @@ pub const ROOT_STEPS: usize = 16;
 pub fn batch_roots(field: &dyn Field, iso: f32, segments: &[Segment], steps: usize) -> Vec<f32> {
     let n = segments.len();
     let (mut lo, mut hi) = (vec![0.0f32; n], vec![1.0f32; n]);
-    let mut flo: Vec<f32> = segments.iter().map(|s| s.f_inside.min(-f32::MIN_POSITIVE)).collect();
-    let mut fhi: Vec<f32> = segments.iter().map(|s| s.f_outside.max(0.0)).collect();
+    let mut flo: Vec<f32> = segments.iter().map(|s| on_side(s.f_inside, true)).collect();
+    let mut fhi: Vec<f32> = segments.iter().map(|s| on_side(s.f_outside, false)).collect();
     let mut side = vec![0i8; n];
     let mut t = vec![0.5f32; n];
     let mut done = vec![false; n];

@@ -99,6 +99,27 @@ pub fn position(tree: &Octree, key: VertexKey) -> glam::Vec3 {
     p
 }
 
+/// `value` (`f - iso`) held on the side `inside` says it is on: a value rounding put at the level
+/// or beyond it becomes the nearest value on that side (the level itself counts as outside).
+/// Crossings are root-found between the two sides, so both ends must say which they are on.
+pub fn on_side(value: f32, inside: bool) -> f32 {
+    if inside {
+        value.min(-f32::MIN_POSITIVE)
+    } else {
+        value.max(0.0)
+    }
+}
+
+/// The stand-in value of a vertex whose side alone is known (an empty leaf's, proven by its
+/// interval bound); its value is evaluated only if a crossing needs it.
+pub fn side_only(inside: bool) -> f32 {
+    if inside {
+        -f32::MIN_POSITIVE
+    } else {
+        f32::MIN_POSITIVE
+    }
+}
+
 /// Calls `emit` once per dual cell of the octree whose vertices are not all on one side.
 pub fn for_each_mixed_cell(tree: &Octree, mut emit: impl FnMut(&[VertexKey; 8])) {
     let mut seen = rustc_hash::FxHashSet::default();

@@ -126,14 +126,7 @@ impl<'a> Fidelity<'a> {
         }
         let inside = super::dual::inside(tree, key);
         let (field, iso) = (self.field, self.iso);
-        let v = *self.values.entry(key).or_insert_with(|| {
-            let v = field.value(p) - iso;
-            if inside {
-                v.min(-f32::MIN_POSITIVE)
-            } else {
-                v.max(0.0)
-            }
-        });
+        let v = *self.values.entry(key).or_insert_with(|| super::dual::on_side(field.value(p) - iso, inside));
         (p, v)
     }
 }

@@ -5,11 +5,12 @@
 //!
 //! The octree is built in one pass, bottom-up, so that what is right at the finest level stays
 //! right (the phases, one file each):
-//! - [`tree`]: the octree, clipped to the finest grid (the grid Marching Cubes would use).
+//! - [`tree`]: the octree of cubic finest cells, clipped to the bounds.
 //! - [`build`]: the crust (every finest cell the surface may reach, by interval bounds, never by
 //!   samples) and its sampling: one 4-D QEF ([`qef`]) per crust cell.
 //! - [`simplify`]: eight leaves become one where their summed QEF fits one vertex within the
-//!   tolerance and [`safety`] proves the contour's topology unchanged.
+//!   tolerance, [`safety`] proves the contour's topology unchanged and [`fidelity`] finds the
+//!   merged triangles within the tolerance of the surface.
 //! - [`dual`]: the dual cells, one per octree vertex, the grid's boundary included.
 //! - [`contour`]: Marching Cubes on the dual cells, crossings by root finding per dual edge.
 //! - [`slivers`]: crossings within a tenth of a cell of a dual vertex moved onto it, the slivers
@@ -23,10 +24,12 @@
 //! surface's wherever the surface's features are wider than a finest cell, and a wall thinner
 //! than a cell is kept wherever a vertex falls inside it (the QEF puts the vertex on the wall's
 //! medial ridge). Vertices stay inside their leaves; that does not keep every dual cell convex,
-//! so the mesh may fold near thin features (measured in the tests, not repaired).
+//! so the mesh may fold or cross itself near features, which [`untangle`] repairs without
+//! changing any vertex's side (so without changing the topology), where it can.
 //!
 //! **Options.** `tolerance` is a fraction of the longest side of the bounds: the largest
-//! root-mean-square 4-D distance of a leaf's sampled tangent planes from its vertex. `max_depth`
+//! root-mean-square 4-D distance of a leaf's sampled tangent planes from its vertex, and the
+//! largest distance of a merged leaf's triangles from the surface. `max_depth`
 //! sets the finest level (`2^max_depth` finest cells along the longest side, the `res` reported).
 
 pub mod bounds;
@@ -124,8 +127,10 @@ pub struct DmcStats {
     /// Merges made, and merges the QEF allowed but the topological safety test refused.
     pub merges: usize,
     pub unsafe_merges: usize,
-    /// Merges refused because their triangles would stray beyond the tolerance.
+    /// Merges refused because their triangles would stray beyond the tolerance, and because the
+    /// QEF's residual was above it.
     pub inaccurate_merges: usize,
+    pub qef_refused_merges: usize,
     /// Triangles crossing another or folded onto a neighbour, before and after [`untangle`], and
     /// the vertices it moved.
     pub crossing_triangles_before: usize,
@@ -214,6 +219,7 @@ pub fn mesh_field(
         stats.merges = s.merged;
         stats.unsafe_merges = s.unsafe_merges;
         stats.inaccurate_merges = s.inaccurate_merges;
+        stats.qef_refused_merges = s.qef_refused;
     }
     stats.simplify_ms = ms_since(t);
 

@@ -98,7 +98,7 @@ pub fn move_toward_centres(
         let value = field.value(target) - iso;
         let node = &mut tree.nodes[n as usize];
         node.vertex = target;
-        node.value = if inside { value.min(-f32::MIN_POSITIVE) } else { value.max(0.0) };
+        node.value = super::dual::on_side(value, inside);
     }
     (nodes.len(), unmerge.len())
 }
