@@ -71,7 +71,6 @@ mod ops;
 mod params;
 mod parser;
 mod program;
-pub mod regions;
 mod shapes;
 pub mod speed;
 mod tape;
@@ -85,7 +84,6 @@ pub use csg::CsgNode;
 pub use diag::Span;
 pub use interval::Choice;
 pub use program::Program;
-pub use regions::{RegionalProgram, TapeLengths};
 
 use crate::error::Error;
 
