@@ -5,15 +5,23 @@
 //   const result = await mesher.meshExpr("sphere(0.8)", { method: "emc", res: 64 });
 //
 // Each call resolves to the same MeshResult as the synchronous function of the same name, its
-// typed arrays transferred from the worker. `cancel()` (or aborting a call's signal) stops the
-// work in flight at once: pending calls reject with a MeshingCancelled (name "AbortError").
+// typed arrays transferred from the worker. The worker stays warm between calls (its compiled
+// module kept), and calls run one at a time in order. `cancel()` (or aborting a call's signal)
+// rejects the pending calls with a MeshingCancelled (name "AbortError") at once; the running call
+// stops at its next checkpoint where the page is cross-origin isolated (SharedArrayBuffer), and is
+// otherwise left to finish unseen, its worker replaced if it runs `staleMs` longer.
 
 import type { CsgNode, GridOptions, MeshOptions, MeshResult } from "./isoforge.js";
 
 /** Optional control of one call. */
 export interface CallControl {
-  /** Aborting it cancels the mesher's work in flight (this call and any other). */
+  /** Aborting it cancels this call (and, if it is running, stops it like cancel()). */
   signal?: AbortSignal;
+  /**
+   * Called while the call runs, at most every 100 ms, with the phase (a key of
+   * `stats.phases_ms`, or "analysis") and how far it got (0 to 1).
+   */
+  onProgress?: (progress: { phase: string; fraction: number }) => void;
 }
 
 /** The rejection of calls stopped by cancel() or an AbortSignal. */
@@ -37,13 +45,19 @@ export interface Mesher {
   ): Promise<MeshResult>;
   /** The mesh as file bytes (the arrays of `result` are copied to the worker, not transferred). */
   exportMesh(result: MeshResult, format: ExportFormat, control?: CallControl): Promise<Uint8Array>;
-  /** Calls in flight. */
+  /** Calls in flight: the running one and those waiting. */
   readonly busy: number;
-  /** Stops the work in flight now; pending calls reject with MeshingCancelled. The mesher stays usable. */
+  /** Whether cancel() stops a running call at its next checkpoint (the page is cross-origin isolated). */
+  readonly stopsAtOnce: boolean;
+  /** Rejects every pending call with MeshingCancelled and stops the running one; the worker stays warm. */
   cancel(): void;
-  /** Same as cancel(): the worker is started again only if the mesher is used again. */
+  /** cancel(), then ends the worker and frees its memory; it is started again if the mesher is used again. */
   terminate(): void;
 }
 
-/** A mesher with its own worker. `workerUrl` overrides where the worker script is loaded from. */
-export function createMesher(options?: { workerUrl?: string | URL }): Mesher;
+/**
+ * A mesher with its own worker. `workerUrl` overrides where the worker script is loaded from;
+ * `staleMs` (default 250) is how long a cancelled call may keep running before its worker is
+ * replaced.
+ */
+export function createMesher(options?: { workerUrl?: string | URL; staleMs?: number }): Mesher;

@@ -1,9 +1,16 @@
 // createMesher(): the package's meshing functions in a Web Worker, so a page never freezes while a
 // mesh is computed, and a newer request can cancel one in flight.
 //
-// Meshing is one synchronous WebAssembly call, which cannot be interrupted from outside; so
-// cancelling terminates the worker (and with it the call) and the next request starts a fresh
-// one. That costs a module instantiation (a few milliseconds), far less than waiting.
+// The worker stays warm: it keeps its compiled module between calls, so a call pays only for
+// meshing. Calls run one at a time, in order; `cancel()` rejects the calls still waiting at once
+// (they never reach the worker) and stops the one running:
+// - where the page can share memory with the worker (`crossOriginIsolated`, so SharedArrayBuffer
+//   exists), through a flag the meshers read at their checkpoints between slabs and octree
+//   levels: the call stops within a few milliseconds and the worker stays;
+// - elsewhere the running call cannot be told, so it is left to finish (its result is dropped).
+// Either way, a call still running `staleMs` after its cancel (default 250 ms) has its worker
+// terminated, and a fresh one takes what comes next: short calls never pay for a restart, long
+// ones never hold up their successor by more than `staleMs`.
 
 /** Thrown (as the rejection of a pending call) when `cancel()` or an AbortSignal stopped it. */
 export class MeshingCancelled extends Error {
@@ -13,50 +20,104 @@ export class MeshingCancelled extends Error {
   }
 }
 
-export function createMesher({ workerUrl } = {}) {
+const CANCELLED = 'meshing cancelled';
+
+export function createMesher({ workerUrl, staleMs = 250 } = {}) {
   let worker = null;
   let nextId = 1;
-  const pending = new Map();
-
-  const failAll = (error) => {
-    for (const { reject } of pending.values()) reject(error);
-    pending.clear();
-  };
+  /** Calls not yet sent, oldest first: { id, name, args, resolve, reject, onProgress }. */
+  const queue = [];
+  /** The call the worker is running, or null. */
+  let running = null;
+  let staleTimer = null;
+  // Job ids up to cancelFlag[0] are cancelled; the worker's progress hook reads it.
+  const cancelFlag = globalThis.crossOriginIsolated && typeof SharedArrayBuffer === 'function'
+    ? new Int32Array(new SharedArrayBuffer(4))
+    : null;
 
   const start = () => {
     // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
     worker = workerUrl
       ? new Worker(workerUrl, { type: 'module' })
       : new Worker(new URL('./mesher-worker.js', import.meta.url), { type: 'module' });
-    worker.onmessage = ({ data: { id, result, error } }) => {
-      const job = pending.get(id);
-      if (!job) return;
-      pending.delete(id);
-      if (error !== undefined) job.reject(new Error(error));
+    if (cancelFlag) worker.postMessage({ cancelFlag: cancelFlag.buffer });
+    worker.onmessage = ({ data: { id, result, error, progress } }) => {
+      const job = running;
+      if (!job || job.id !== id) return;
+      if (progress) {
+        job.onProgress?.(progress);
+        return;
+      }
+      finish();
+      if (job.abandoned) return;
+      if (error === CANCELLED) job.reject(new MeshingCancelled());
+      else if (error !== undefined) job.reject(new Error(error));
       else job.resolve(result);
     };
-    // A crash (out of memory, say) loses the worker and every call in it.
+    // A crash (out of memory, say) loses the worker and the call it was running.
     worker.onerror = (event) => {
       event.preventDefault();
-      worker.terminate();
-      worker = null;
-      failAll(new Error(`the meshing worker failed: ${event.message || 'out of memory?'}`));
+      const job = running;
+      stop();
+      if (job && !job.abandoned) job.reject(new Error(`the meshing worker failed: ${event.message || 'out of memory?'}`));
+      pump();
     };
+  };
+
+  /** The running call is over: send the next one. */
+  const finish = () => {
+    running = null;
+    clearTimeout(staleTimer);
+    staleTimer = null;
+    pump();
+  };
+
+  const stop = () => {
+    worker?.terminate();
+    worker = null;
+    running = null;
+    clearTimeout(staleTimer);
+    staleTimer = null;
+  };
+
+  const pump = () => {
+    if (running || queue.length === 0) return;
+    if (!worker) start();
+    running = queue.shift();
+    const { id, name, args } = running;
+    worker.postMessage({ id, call: name, args });
   };
 
   const cancel = () => {
-    if (worker) worker.terminate();
-    worker = null;
-    failAll(new MeshingCancelled());
+    for (const job of queue.splice(0)) job.reject(new MeshingCancelled());
+    if (!running || running.abandoned) return;
+    running.abandoned = true;
+    running.reject(new MeshingCancelled());
+    if (cancelFlag) Atomics.store(cancelFlag, 0, running.id);
+    // Without shared memory, or in a stretch without checkpoints, a call may not stop: past
+    // `staleMs` the worker goes, and a fresh one takes the next call.
+    const stale = running;
+    staleTimer = setTimeout(() => {
+      if (running !== stale) return;
+      stop();
+      pump();
+    }, staleMs);
   };
 
-  const call = (name, args, { signal } = {}) => new Promise((resolve, reject) => {
+  const call = (name, args, { signal, onProgress } = {}) => new Promise((resolve, reject) => {
     if (signal?.aborted) return reject(new MeshingCancelled());
-    if (!worker) start();
-    const id = nextId++;
-    pending.set(id, { resolve, reject });
-    signal?.addEventListener('abort', () => { if (pending.has(id)) cancel(); }, { once: true });
-    worker.postMessage({ id, call: name, args });
+    const job = { id: nextId++, name, args, resolve, reject, onProgress, abandoned: false };
+    signal?.addEventListener('abort', () => {
+      const waiting = queue.indexOf(job);
+      if (waiting >= 0) {
+        queue.splice(waiting, 1);
+        reject(new MeshingCancelled());
+      } else if (running === job) {
+        cancel();
+      }
+    }, { once: true });
+    queue.push(job);
+    pump();
   });
 
   return {
@@ -65,9 +126,14 @@ export function createMesher({ workerUrl } = {}) {
     meshCsg: (tree, options, control) => call('meshCsg', [typeof tree === 'string' ? tree : JSON.stringify(tree), options], control),
     meshGrid: (values, dims, bounds, options, control) => call('meshGrid', [values, dims, bounds, options], control),
     exportMesh: (result, format, control) => call('exportMesh', [result, format], control),
-    /** Calls in flight. */
-    get busy() { return pending.size; },
+    /** Calls in flight: the running one and those waiting. */
+    get busy() { return queue.length + (running && !running.abandoned ? 1 : 0); },
+    /** Whether a running call can be stopped at once (shared memory), rather than left to finish. */
+    get stopsAtOnce() { return cancelFlag !== null; },
     cancel,
-    terminate: cancel,
+    terminate: () => {
+      cancel();
+      stop();
+    },
   };
 }

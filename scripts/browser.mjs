@@ -3,10 +3,14 @@
 import { spawn } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
-/** Serves `dir` on 127.0.0.1 at a random port; resolves to { url, close }. */
-export async function serve(dir = 'www') {
+/**
+ * Serves `dir` on 127.0.0.1 at a random port, cross-origin isolated unless `isolated` is false;
+ * resolves to { url, close }.
+ */
+export async function serve(dir = 'www', { isolated = true } = {}) {
   const port = 8000 + Math.floor(Math.random() * 2000);
-  const server = spawn(process.execPath, ['scripts/serve.mjs', dir, String(port)], { stdio: ['ignore', 'pipe', 'inherit'] });
+  const args = ['scripts/serve.mjs', dir, String(port), ...(isolated ? [] : ['--not-isolated'])];
+  const server = spawn(process.execPath, args, { stdio: ['ignore', 'pipe', 'inherit'] });
   await new Promise((resolve, reject) => {
     server.stdout.once('data', resolve);
     server.once('exit', (code) => reject(new Error(`server exited with ${code}`)));

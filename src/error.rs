@@ -28,6 +28,8 @@ pub enum Error {
     /// A user-supplied field function (see [`crate::field::BatchFn`]) failed or returned a batch
     /// of the wrong size.
     FieldFunction(String),
+    /// The job's progress hook asked it to stop (see [`crate::progress`]).
+    Cancelled,
 }
 
 impl fmt::Display for Error {
@@ -49,6 +51,7 @@ impl fmt::Display for Error {
             }
             Error::Io(msg) => write!(f, "{msg}"),
             Error::FieldFunction(msg) => write!(f, "field function: {msg}"),
+            Error::Cancelled => write!(f, "meshing cancelled"),
             Error::NonFiniteOutput { method, index, position } => write!(
                 f,
                 "{method} produced vertex {index} at ({}, {}, {}): the input's values or coordinates are too \

@@ -187,23 +187,56 @@ pub fn finite_difference_gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
     ) / (2.0 * h)
 }
 
-/// Samples `field` at every point of `grid`, row by row through [`Field::values`].
+/// Samples `field` at every point of `grid`, one tile of [`TILE`]³ points per [`Field::values`]
+/// call: a field specialised per region ([`crate::expr::RegionalProgram`]) then gets long runs of
+/// points in one brick, where rows would cut every brick into a few points each.
 /// Fails on the first non-finite value, naming it, because meshing it would be silently wrong.
 pub fn sample_grid(field: &dyn Field, grid: &Grid) -> Result<Vec<f32>, Error> {
-    let [nx, ny, nz] = grid.points();
     let mut values = vec![0.0f32; grid.point_count()];
-    let mut row = vec![Vec3::ZERO; nx];
-    for k in 0..nz {
-        for j in 0..ny {
-            for (i, p) in row.iter_mut().enumerate() {
-                *p = grid.position(i, j, k);
+    let mut points = Vec::with_capacity(TILE * TILE * TILE);
+    let mut indices = Vec::with_capacity(TILE * TILE * TILE);
+    let mut out = vec![0.0f32; TILE * TILE * TILE];
+    for_each_tile(grid.points(), "sample", |lo, hi| {
+        points.clear();
+        indices.clear();
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                for i in lo[0]..hi[0] {
+                    points.push(grid.position(i, j, k));
+                    indices.push(grid.index(i, j, k));
+                }
             }
-            let start = grid.index(0, j, k);
-            field.values(&row, &mut values[start..start + nx]);
         }
-    }
+        field.values(&points, &mut out[..points.len()]);
+        for (&n, &v) in indices.iter().zip(&out) {
+            values[n] = v;
+        }
+    })?;
     check_finite(&values, grid)?;
     Ok(values)
+}
+
+/// Points per side of the tiles that grids are sampled in.
+pub const TILE: usize = 8;
+
+/// Calls `visit(lo, hi)` for each tile of at most [`TILE`]³ of the `points` of a grid (index
+/// ranges, half-open), x fastest, with a [`crate::progress::checkpoint`] of `phase` before each
+/// slab of tiles.
+pub fn for_each_tile(
+    points: [usize; 3],
+    phase: &'static str,
+    mut visit: impl FnMut([usize; 3], [usize; 3]),
+) -> Result<(), Error> {
+    for k in (0..points[2]).step_by(TILE) {
+        crate::progress::checkpoint(phase, k as f32 / points[2] as f32)?;
+        for j in (0..points[1]).step_by(TILE) {
+            for i in (0..points[0]).step_by(TILE) {
+                let lo = [i, j, k];
+                visit(lo, [0, 1, 2].map(|a| (lo[a] + TILE).min(points[a])));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Fails with [`Error::NonFiniteSample`] naming the first NaN or infinite sample, and with

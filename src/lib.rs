@@ -19,6 +19,7 @@
 //!
 //! The algorithm core knows nothing of JavaScript; `wasm` (only on wasm32) is a thin binding layer.
 
+pub mod crust;
 pub mod dmc;
 pub mod emc;
 pub mod error;
@@ -30,6 +31,7 @@ pub mod mc;
 pub mod mcq;
 pub mod mesh;
 pub mod pipeline;
+pub mod progress;
 pub mod quad;
 pub mod scenes;
 pub mod stats;

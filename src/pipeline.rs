@@ -6,7 +6,7 @@
 use crate::dmc::{self, DmcOptions, DmcStats};
 use crate::emc::{self, EmcMesh, EmcOptions};
 use crate::error::Error;
-use crate::expr::{self, Program};
+use crate::expr::{self, Program, RegionalProgram};
 use crate::field::{BatchFn, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
@@ -14,7 +14,7 @@ use crate::mcq::{self, McqOptions, PolygonRules};
 use crate::mesh::Mesh;
 use crate::quad::{self, QuadOptions};
 use crate::scenes;
-use crate::stats::{self, AnalysisOptions, Stats};
+use crate::stats::{self, AnalysisOptions, Stats, TapeStats};
 use glam::Vec3;
 
 mod inputs;
@@ -286,6 +286,7 @@ impl Meshed {
             let position = self.mesh.positions[index].to_array();
             return Err(Error::NonFiniteOutput { method: method.name(), index, position });
         }
+        crate::progress::checkpoint("analysis", 0.0)?;
         let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
         stats.points_evaluated = self.evaluations.map(|e| e.0);
@@ -342,12 +343,26 @@ pub const DEFAULT_BOUNDS: (Vec3, Vec3) = (Vec3::splat(-1.0), Vec3::splat(1.0));
 /// Meshes a built-in scene (see [`scenes::SCENE_NAMES`]) in its own bounds.
 pub fn mesh_scene(name: &str, request: &Request) -> Result<Output, Error> {
     let scene = scenes::scene(name)?;
-    mesh_field(scene.field.as_ref(), (scene.min, scene.max), request)
+    mesh_program_in(&scene.field, (scene.min, scene.max), request)
 }
 
 /// Meshes a compiled program over the request's bounds, or [`DEFAULT_BOUNDS`].
 pub fn mesh_program(program: &Program, request: &Request) -> Result<Output, Error> {
-    mesh_field(program, DEFAULT_BOUNDS, request)
+    mesh_program_in(program, DEFAULT_BOUNDS, request)
+}
+
+/// Leaf bricks of the tape octree are about this many cells of the finest grid on a side.
+const CELLS_PER_BRICK: usize = 4;
+
+/// [`mesh_field`] through a [`RegionalProgram`]: every query, from the crust's intervals to the
+/// analysis's distances, runs on a tape specialised to the brick it falls in.
+pub fn mesh_program_in(program: &Program, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error> {
+    let (min, max) = request.bounds.unwrap_or(bounds);
+    let depth = RegionalProgram::depth_for(request.reported_res(), CELLS_PER_BRICK);
+    let regional = RegionalProgram::new(program, min, max, depth);
+    let mut output = mesh_field(&regional, bounds, request)?;
+    output.stats.tape = Some(TapeStats::from(&regional.tape_lengths()));
+    Ok(output)
 }
 
 /// Compiles a program in the expression language and meshes it like [`mesh_program`]. A

@@ -20,7 +20,7 @@ pub struct Scene {
     pub min: Vec3,
     pub max: Vec3,
     /// The compiled [`Scene::source`].
-    pub field: Box<dyn Field + Send + Sync>,
+    pub field: Box<expr::Program>,
     /// Euler characteristic of the true surface, where it is known analytically. A mesh only has
     /// it once the grid resolves the shape: `thin_room`'s walls need far finer grids than usual.
     pub euler: Option<i64>,

@@ -89,6 +89,35 @@ pub struct Stats {
     pub quads: usize,
     /// The quad method's record per stage: valence-four share, aspect ratios, distance.
     pub quad_stages: Vec<crate::quad::QuadStage>,
+    /// How far the program's tape was specialised per brick (programs only, `None` otherwise).
+    pub tape: Option<TapeStats>,
+}
+
+/// The distribution of specialised tape lengths (instructions) over the leaf bricks that were
+/// queried (see [`crate::expr::regions`]).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq, Default)]
+pub struct TapeStats {
+    /// The whole program's length.
+    pub full: usize,
+    /// Leaf bricks built (the rest of space was never queried at leaf level).
+    pub bricks: usize,
+    pub min: usize,
+    pub p50: usize,
+    pub p90: usize,
+    pub max: usize,
+}
+
+impl From<&crate::expr::TapeLengths> for TapeStats {
+    fn from(lengths: &crate::expr::TapeLengths) -> TapeStats {
+        TapeStats {
+            full: lengths.full,
+            bricks: lengths.leaves.len(),
+            min: lengths.quantile(0.0),
+            p50: lengths.quantile(0.5),
+            p90: lengths.quantile(0.9),
+            max: lengths.quantile(1.0),
+        }
+    }
 }
 
 impl Stats {

@@ -27,6 +27,49 @@ fn start() {
     console_error_panic_hook::set_once();
 }
 
+thread_local! {
+    static PROGRESS_HOOK: std::cell::RefCell<Option<js_sys::Function>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Installs `hook(phase, fraction)` for every later meshing call (in this worker or page): the
+/// meshers call it between slabs, octree levels and passes with the phase's name (the keys of
+/// `stats.phases_ms`, and `"analysis"`) and how far it got, 0 to 1. Returning `true` stops the
+/// call, which then throws an `Error` "meshing cancelled"; that is how `createMesher` abandons a
+/// superseded request without restarting its worker. `undefined` removes the hook.
+#[wasm_bindgen(js_name = setProgressHook)]
+pub fn set_progress_hook(
+    #[wasm_bindgen(
+        unchecked_param_type = "((phase: string, fraction: number) => boolean | void) | undefined"
+    )]
+    hook: JsValue,
+) -> Result<(), JsValue> {
+    let hook = if hook.is_undefined() || hook.is_null() {
+        None
+    } else {
+        Some(
+            hook.dyn_into::<js_sys::Function>()
+                .map_err(|_| js_error("the progress hook must be a function"))?,
+        )
+    };
+    PROGRESS_HOOK.with(|h| *h.borrow_mut() = hook);
+    Ok(())
+}
+
+/// Runs a meshing job under the installed progress hook, if any. A hook that throws is ignored
+/// (the job goes on): a bug in a listener should not lose the mesh.
+fn with_progress<R>(job: impl FnOnce() -> R) -> R {
+    match PROGRESS_HOOK.with(|h| h.borrow().clone()) {
+        None => job(),
+        Some(hook) => crate::progress::with_hook(
+            move |phase, fraction| {
+                hook.call2(&JsValue::NULL, &JsValue::from_str(phase), &JsValue::from_f64(fraction as f64))
+                    .is_ok_and(|stop| stop.is_truthy())
+            },
+            job,
+        ),
+    }
+}
+
 fn js_error(e: impl std::fmt::Display) -> JsValue {
     js_sys::Error::new(&e.to_string()).into()
 }
@@ -81,7 +124,7 @@ pub fn mesh_scene(
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
-    to_js(&pipeline::mesh_scene(name, &request).map_err(js_error)?)
+    to_js(&with_progress(|| pipeline::mesh_scene(name, &request)).map_err(js_error)?)
 }
 
 /// A compiled program in the expression language, reusable across meshing calls: compile once,
@@ -200,7 +243,7 @@ pub fn mesh_shape(
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
-    to_js(&pipeline::mesh_program(&shape.program, &request).map_err(js_error)?)
+    to_js(&with_progress(|| pipeline::mesh_program(&shape.program, &request)).map_err(js_error)?)
 }
 
 /// Compiles and meshes a program in the expression language, in `options.bounds` or [-1, 1]³.
@@ -211,7 +254,7 @@ pub fn mesh_expr(
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
-    to_js(&pipeline::mesh_expr(text, &request).map_err(js_error)?)
+    to_js(&with_progress(|| pipeline::mesh_expr(text, &request)).map_err(js_error)?)
 }
 
 /// Compiles and meshes a CSG tree (a JSON string or a `CsgNode` object), in `options.bounds` or
@@ -222,7 +265,8 @@ pub fn mesh_csg(
     #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
-    to_js(&pipeline::mesh_csg_json(&csg_text(&json)?, &request).map_err(js_error)?)
+    let text = csg_text(&json)?;
+    to_js(&with_progress(|| pipeline::mesh_csg_json(&text, &request)).map_err(js_error)?)
 }
 
 /// The samples of a meshGrid call as `f32`, whatever array type they came in.
@@ -292,7 +336,7 @@ pub fn mesh_grid(
     let grid = Grid::new(min, max, cells).map_err(js_error)?;
     grid.check_size(request.max_cells).map_err(js_error)?;
     let samples = grid_samples(&values, dtype, &grid)?;
-    to_js(&pipeline::mesh_samples(&samples, &grid, &request).map_err(js_error)?)
+    to_js(&with_progress(|| pipeline::mesh_samples(&samples, &grid, &request)).map_err(js_error)?)
 }
 
 /// The message of whatever a JavaScript function threw.
@@ -346,5 +390,5 @@ pub fn mesh_function(
         },
         1e-3,
     );
-    to_js(&pipeline::mesh_function(&batch, bounds, &request).map_err(js_error)?)
+    to_js(&with_progress(|| pipeline::mesh_function(&batch, bounds, &request)).map_err(js_error)?)
 }

@@ -7,7 +7,7 @@ use common::assert_watertight;
 use isoforge::expr::{self, Program};
 use isoforge::mc::{self, McOptions};
 use isoforge::mesh::analysis;
-use isoforge::{scenes, Grid, Vec3};
+use isoforge::{scenes, Field, Grid, Vec3};
 
 #[cfg(target_arch = "wasm32")]
 use wasm_bindgen_test::wasm_bindgen_test as test;

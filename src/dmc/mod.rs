@@ -200,6 +200,7 @@ pub fn mesh_field(
     let iso = options.iso;
     let mut stats = DmcStats::default();
 
+    crate::progress::checkpoint("octree", 0.0)?;
     let t = Instant::now();
     let mut tree = Octree::new(min, max, options.max_depth);
     let mut built = build::crust(&mut tree, field, iso, options.samples_per_cell, options.max_cells)?;
@@ -207,12 +208,14 @@ pub fn mesh_field(
 
     let longest = (max - min).max_element();
     let tolerance = options.tolerance * longest;
+    crate::progress::checkpoint("octree", 0.5)?;
     let t = Instant::now();
     build::sample(&mut tree, &clipped, iso, options.samples_per_cell, &mut built);
     stats.sampling_ms = ms_since(t);
     stats.crust_cells = built.crust_cells;
     stats.samples = built.samples;
 
+    crate::progress::checkpoint("feature_isolation", 0.0)?;
     let t = Instant::now();
     if options.simplify {
         let s = simplify::simplify(&mut tree, field, iso, tolerance);
@@ -228,6 +231,7 @@ pub fn mesh_field(
     dual::for_each_mixed_cell(&tree, |cell| keys.push(*cell));
     stats.dual_cells = keys.len();
     stats.dual_ms = ms_since(t);
+    crate::progress::checkpoint("contouring", 0.0)?;
     let t = Instant::now();
     let mut moves = vec![0u8; tree.nodes.len()];
     let mut origins = rustc_hash::FxHashMap::default();
@@ -236,6 +240,7 @@ pub fn mesh_field(
     stats.contour_ms = ms_since(t);
     let t = Instant::now();
     for round in 0..=untangle::ROUNDS {
+        crate::progress::checkpoint("untangling", round as f32 / untangle::ROUNDS as f32)?;
         let offending = untangle::offending_triangles(&contour.mesh);
         stats.crossing_triangles = offending.len();
         if round == 0 {

@@ -10,7 +10,6 @@
 //! and oriented point clouds ([`point_source::reconstruct`], tangent planes): the paper's §3.1
 //! directed distances for its remeshing (§5.3) and reconstruction (§5.2) applications.
 
-pub mod crust;
 pub mod directed;
 pub mod edges;
 pub mod feature;
@@ -166,7 +165,8 @@ pub fn mesh_field(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let crust = if options.crust { crust::sample_crust(field, grid, options.iso).transpose()? } else { None };
+    let crust =
+        if options.crust { crate::crust::sample_crust(field, grid, options.iso).transpose()? } else { None };
     let (values, evaluated) = match crust {
         Some(c) => (c.values, c.evaluated),
         None => (sample_grid(field, grid)?, grid.point_count()),
@@ -208,9 +208,10 @@ pub fn mesh_with_sampler(
     check_finite(values, grid)?;
     let mut timings = EmcTimings::default();
     let t1 = Instant::now();
-    let (mut out, mut centres, outside) = extract(values, grid, options, sampler);
+    let (mut out, mut centres, outside) = extract(values, grid, options, sampler)?;
     out.grid_points = grid.point_count();
     timings.extract_ms = ms_since(t1);
+    crate::progress::checkpoint("flip", 0.0)?;
     let t2 = Instant::now();
     // Flip, then pull back the fans outside their cell that cut a neighbour's triangles; where any
     // moved, flip again from the unflipped mesh, so that no flip is kept that was made for a
@@ -265,7 +266,7 @@ fn extract(
     grid: &Grid,
     options: &EmcOptions,
     sampler: &dyn EdgeSampler,
-) -> (EmcMesh, FanCentres, Vec<OutsideFan>) {
+) -> Result<(EmcMesh, FanCentres, Vec<OutsideFan>), Error> {
     let [nx, ny, _] = grid.points();
     let [cx, cy, cz] = grid.cells;
     let mut out = EmcMesh::default();
@@ -281,6 +282,7 @@ fn extract(
     let mut centres = FanCentres::default();
 
     for k in 0..cz {
+        crate::progress::checkpoint("extract", k as f32 / cz as f32)?;
         if k > 0 {
             cache.advance();
         }
@@ -417,7 +419,7 @@ fn extract(
         }
     }
     out.mesh.normals = normals_of_vertex;
-    (out, centres, outside_fans)
+    Ok((out, centres, outside_fans))
 }
 
 /// Per vertex: is it the centre of a feature fan (on the feature or approximately), and is it on

@@ -356,8 +356,8 @@ pub fn eval_interval_with_choices(tape: &Tape, lo: Vec3, hi: Vec3) -> (Interval,
     let mut choices = Vec::with_capacity(tape.choice_count());
     let r = run(tape, inputs(lo, hi), |op, a: Interval, b: Interval| {
         let (left_wins, right_wins) = match op {
-            BinaryOp::Min => (a.hi <= b.lo, b.hi < a.lo),
-            BinaryOp::Max => (a.lo >= b.hi, b.lo > a.hi),
+            BinaryOp::Min => (a.hi < b.lo, b.hi < a.lo),
+            BinaryOp::Max => (a.lo > b.hi, b.lo > a.hi),
             _ => return,
         };
         // Where the winner is NaN the min/max returns the loser: a partial winner cannot stand in.

@@ -71,6 +71,7 @@ mod ops;
 mod params;
 mod parser;
 mod program;
+pub mod regions;
 mod shapes;
 pub mod speed;
 mod tape;
@@ -84,6 +85,7 @@ pub use csg::CsgNode;
 pub use diag::Span;
 pub use interval::Choice;
 pub use program::Program;
+pub use regions::{RegionalProgram, TapeLengths};
 
 use crate::error::Error;
 

@@ -7,7 +7,6 @@ use super::eval::{eval_gradient, eval_point};
 use super::graph::{Graph, Node, NodeId};
 use super::interval::{self, Choice};
 use super::ops::BinaryOp;
-use super::shapes::Emit;
 use super::tape::Tape;
 use super::Script;
 use crate::error::Error;
@@ -98,33 +97,60 @@ impl Program {
     /// A shorter program equal to this one wherever `choices` hold (typically inside the box
     /// they were computed for): each decided min/max is replaced by its winning operand, and
     /// whatever only the loser needed disappears. Missing choices count as [`Choice::Both`].
+    /// Values and gradients are bit for bit the full program's wherever the choices hold (a
+    /// choice is only made when one side wins strictly, so no tie rule is involved).
     pub fn simplify(&self, choices: &[Choice]) -> Program {
-        let mut graph = Graph::new();
-        let mut map: Vec<NodeId> = Vec::with_capacity(self.nodes.len());
-        let mut k = 0;
-        for node in &self.nodes {
-            let id = match *node {
-                Node::Const(bits) => graph.constant(f32::from_bits(bits)),
-                Node::Input(axis) => graph.input(axis),
-                Node::Unary(op, a) => graph.unary(op, map[a as usize]),
-                Node::Binary(op, a, b) => {
-                    let (a, b) = (map[a as usize], map[b as usize]);
-                    if matches!(op, BinaryOp::Min | BinaryOp::Max) {
-                        let choice = choices.get(k).copied().unwrap_or(Choice::Both);
-                        k += 1;
-                        match choice {
-                            Choice::Left => a,
-                            Choice::Right => b,
-                            Choice::Both => graph.binary(op, a, b),
-                        }
-                    } else {
-                        graph.binary(op, a, b)
-                    }
-                }
-            };
-            map.push(id);
+        self.specialize(choices).unwrap_or_else(|| self.clone())
+    }
+
+    /// [`Program::simplify`], or `None` when no choice removes anything. One forward and one
+    /// backward sweep over the node list, no hashing: cheap enough to run per brick of a grid.
+    pub fn specialize(&self, choices: &[Choice]) -> Option<Program> {
+        if !choices.iter().any(|c| *c != Choice::Both) {
+            return None;
         }
-        Program::from_graph(&graph, map[self.root as usize])
+        // Forward: a decided min/max stands for its winner (itself possibly an alias).
+        let mut alias: Vec<NodeId> = (0..self.nodes.len() as NodeId).collect();
+        let mut k = 0;
+        for (i, node) in self.nodes.iter().enumerate() {
+            if let Node::Binary(BinaryOp::Min | BinaryOp::Max, a, b) = *node {
+                match choices.get(k).copied().unwrap_or(Choice::Both) {
+                    Choice::Left => alias[i] = alias[a as usize],
+                    Choice::Right => alias[i] = alias[b as usize],
+                    Choice::Both => {}
+                }
+                k += 1;
+            }
+        }
+        // Backward: what the (aliased) root still reads.
+        let root = alias[self.root as usize] as usize;
+        let mut live = vec![false; self.nodes.len()];
+        live[root] = true;
+        for i in (0..=root).rev() {
+            if live[i] {
+                for a in self.nodes[i].operands() {
+                    live[alias[a as usize] as usize] = true;
+                }
+            }
+        }
+        let mut renumber = vec![0 as NodeId; self.nodes.len()];
+        let mut nodes = Vec::with_capacity(self.nodes.len());
+        for (i, node) in self.nodes.iter().enumerate() {
+            if !live[i] {
+                continue;
+            }
+            let to = |a: NodeId| renumber[alias[a as usize] as usize];
+            let renumbered = match *node {
+                Node::Unary(op, a) => Node::Unary(op, to(a)),
+                Node::Binary(op, a, b) => Node::Binary(op, to(a), to(b)),
+                other => other,
+            };
+            renumber[i] = nodes.len() as NodeId;
+            nodes.push(renumbered);
+        }
+        let root = renumber[root];
+        let tape = Tape::from_nodes(&nodes, root);
+        Some(Program { nodes, root, tape })
     }
 
     /// Instructions on the tape (constants and coordinate loads not counted).

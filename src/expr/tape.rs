@@ -81,9 +81,12 @@ impl Tape {
             };
             instrs.push(instr);
             // Free operands after choosing the output slot, so the output never aliases them.
-            let mut operands: Vec<NodeId> = node.operands().collect();
-            operands.dedup();
-            for a in operands {
+            let (a, b) = match *node {
+                Node::Unary(_, a) => (a, a),
+                Node::Binary(_, a, b) => (a, b),
+                _ => unreachable!("constants and inputs were skipped"),
+            };
+            for a in if a == b { [Some(a), None] } else { [Some(a), Some(b)] }.into_iter().flatten() {
                 let a = a as usize;
                 if last_use[a] == i && !matches!(nodes[a], Node::Const(_)) {
                     free.push(slot[a]);

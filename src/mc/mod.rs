@@ -90,7 +90,12 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
     grid.check_size(options.max_cells)?;
     let mut timings = McTimings::default();
     let t0 = Instant::now();
-    let values = sample_grid(field, grid)?;
+    // Where the field bounds itself, only the crust is evaluated: the mesh is the same, since a
+    // cell away from the surface has one sign on either grid (see `crate::crust`).
+    let values = match crate::crust::sample_crust(field, grid, options.iso) {
+        Some(crust) => crust?.values,
+        None => sample_grid(field, grid)?,
+    };
     timings.sample_ms = ms_since(t0);
     let t1 = Instant::now();
     let mut mesh = extract(&values, grid, options)?;

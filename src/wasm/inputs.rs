@@ -46,7 +46,7 @@ pub fn mesh_triangles(
         normals: Vec::new(),
         triangles: indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
     };
-    to_js(&pipeline::mesh_triangles(&mesh, &request).map_err(js_error)?)
+    to_js(&super::with_progress(|| pipeline::mesh_triangles(&mesh, &request)).map_err(js_error)?)
 }
 
 /// Reconstructs the surface an oriented point cloud samples, with EMC (`method: "emc"`, tangent
@@ -62,5 +62,5 @@ pub fn mesh_points(
     let request = parse_options(options)?;
     let cloud =
         PointCloud { positions: triples(positions, "positions")?, normals: triples(normals, "normals")? };
-    to_js(&pipeline::mesh_points(&cloud, &request).map_err(js_error)?)
+    to_js(&super::with_progress(|| pipeline::mesh_points(&cloud, &request)).map_err(js_error)?)
 }

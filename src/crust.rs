@@ -1,5 +1,6 @@
 //! The adaptive "crust" traversal of EMC §2: refine only the parts of the grid that can contain the
-//! surface, and evaluate the field only at the corners of the finest cells that do.
+//! surface, and evaluate the field only at the corners of the finest cells that do. MC and EMC
+//! both sample fields through it.
 //!
 //! The result is sample-for-sample what the uniform grid would give wherever the surface is: a box
 //! whose interval bounds exclude the iso-level has every value of one sign, so its points get a
@@ -7,7 +8,7 @@
 //! sign change on either grid. Cells that may hold the surface are evaluated exactly.
 
 use crate::error::Error;
-use crate::field::Field;
+use crate::field::{for_each_tile, Field, TILE};
 use crate::grid::Grid;
 
 /// Boxes at most this many cells on a side are sampled without further bounding.
@@ -54,10 +55,9 @@ impl Traversal<'_> {
         let (wlo, whi) = (self.grid.position(lo[0], lo[1], lo[2]), self.grid.position(hi[0], hi[1], hi[2]));
         self.interval_queries += 1;
         let (vlo, vhi) = self.field.interval(wlo, whi).unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
-        let (vlo, vhi) = (vlo - self.iso, vhi - self.iso);
-        if vlo > 0.0 || vhi < 0.0 {
-            let stand_in = if vlo > 0.0 { vlo } else { vhi };
-            self.fill(lo, hi, stand_in + self.iso);
+        // The bound itself stands in (not `bound - iso + iso`, which may round onto the level).
+        if vlo > self.iso || vhi < self.iso {
+            self.fill(lo, hi, if vlo > self.iso { vlo } else { vhi });
             return;
         }
         let sizes = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
@@ -101,28 +101,39 @@ impl Traversal<'_> {
         }
     }
 
-    /// Evaluates the marked points in batches (they overwrite stand-ins) and checks them.
+    /// Evaluates the marked points tile by tile (see [`crate::field::sample_grid`]; they
+    /// overwrite stand-ins) and checks them.
     fn finish(mut self) -> Result<CrustSamples, Error> {
-        let indices: Vec<usize> = (0..self.marked.len()).filter(|&n| self.marked[n]).collect();
-        let mut points = Vec::with_capacity(256);
-        let mut out = vec![0.0f32; 256];
-        for chunk in indices.chunks(256) {
+        let mut points = Vec::with_capacity(TILE * TILE * TILE);
+        let mut indices = Vec::with_capacity(TILE * TILE * TILE);
+        let mut out = vec![0.0f32; TILE * TILE * TILE];
+        let mut evaluated = 0;
+        let grid = self.grid;
+        for_each_tile(grid.points(), "sample", |lo, hi| {
             points.clear();
-            points.extend(chunk.iter().map(|&n| {
-                let [i, j, k] = self.grid.unindex(n);
-                self.grid.position(i, j, k)
-            }));
-            self.field.values(&points, &mut out[..chunk.len()]);
-            for (&n, &v) in chunk.iter().zip(&out) {
+            indices.clear();
+            for k in lo[2]..hi[2] {
+                for j in lo[1]..hi[1] {
+                    for i in lo[0]..hi[0] {
+                        let n = grid.index(i, j, k);
+                        if self.marked[n] {
+                            points.push(grid.position(i, j, k));
+                            indices.push(n);
+                        }
+                    }
+                }
+            }
+            if points.is_empty() {
+                return;
+            }
+            self.field.values(&points, &mut out[..points.len()]);
+            for (&n, &v) in indices.iter().zip(&out) {
                 self.values[n] = v;
             }
-        }
+            evaluated += points.len();
+        })?;
         crate::field::check_finite(&self.values, self.grid)?;
-        Ok(CrustSamples {
-            values: self.values,
-            evaluated: indices.len(),
-            interval_queries: self.interval_queries,
-        })
+        Ok(CrustSamples { values: self.values, evaluated, interval_queries: self.interval_queries })
     }
 }
 
