@@ -34,7 +34,7 @@ function frame(b) {
 
 /** Options for one pane's method: grid methods take a resolution, DMC a tolerance and depth. */
 function options(method) {
-  const common = { bounds };
+  const common = { bounds, surfaceError: true };
   if (method === 'dmc') {
     return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
   }

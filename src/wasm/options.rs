@@ -96,7 +96,7 @@ pub(super) fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dt
     }
     r.analysis = AnalysisOptions {
         self_intersections: o.check_intersections.unwrap_or(false),
-        surface_error: o.surface_error.unwrap_or(true),
+        surface_error: o.surface_error.unwrap_or(false),
     };
     // Ranges are checked by the method itself, with the same names.
     r.theta_sharp = o.theta_sharp.unwrap_or(r.theta_sharp);

@@ -142,8 +142,8 @@ test('EMC options are passed through and feature edges come back', async () => {
     }
     const f = emc.featureEdges;
     // Resampled creases (the default) against the paper's tangent-plane points on curved creases.
-    const resampled = m.meshScene('fandisk', { method: 'emc', res: 32 }).stats.dist_max;
-    const paper = m.meshScene('fandisk', { method: 'emc', res: 32, resampleCreases: false }).stats.dist_max;
+    const resampled = m.meshScene('fandisk', { method: 'emc', res: 32, surfaceError: true }).stats.dist_max;
+    const paper = m.meshScene('fandisk', { method: 'emc', res: 32, resampleCreases: false, surfaceError: true }).stats.dist_max;
     // Flat merges (the default) against every fan's two extra triangles kept.
     const kept = m.meshScene('rotated_box', { method: 'emc', res: 24, mergeFlat: false }).stats;
     return {
@@ -172,7 +172,7 @@ test('DMC keeps the thin-walled room whole within 1 %, and refuses the options i
   const room = 'b = max(abs(x) - 0.8, abs(y) - 0.8, abs(z) - 0.5); room = abs(b) - 0.008; '
     + 'door = translate(max(abs(x) - 0.2, abs(y) - 0.1, abs(z) - 0.325), 0, -0.8, -0.125); max(room, -door)';
   const r = await inPage((m, room) => {
-    const base = { method: 'dmc', maxDepth: 6, bounds: [-1, -1, -0.7, 1, 1, 0.7], checkIntersections: true };
+    const base = { method: 'dmc', maxDepth: 6, bounds: [-1, -1, -0.7, 1, 1, 0.7], checkIntersections: true, surfaceError: true };
     const stats = m.meshExpr(room, base).stats;
     const bad = [];
     for (const key of ['vertexReach', 'paperOnly', 'accuracyRule']) {

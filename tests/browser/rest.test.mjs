@@ -97,7 +97,7 @@ test('meshGrid takes a gradient option, trilinear or central', async () => {
       const p = [i, j, k].map((t) => -1 + (2 * t) / (n - 1));
       values[i + n * (j + n * k)] = Math.hypot(...p) - 0.7;
     }
-    const run = (gradient) => m.meshGrid(values, [n, n, n], [-1, -1, -1, 1, 1, 1], gradient ? { gradient } : {}).stats;
+    const run = (gradient) => m.meshGrid(values, [n, n, n], [-1, -1, -1, 1, 1, 1], { surfaceError: true, ...(gradient ? { gradient } : {}) }).stats;
     const err = (f) => { try { f(); return null; } catch (e) { return e.message; } };
     return {
       central: run('central'), trilinear: run('trilinear'), dflt: run(undefined),
