@@ -161,11 +161,16 @@ test('a broken program shows its error inline at its line and column, and nothin
 
 test('the page answers clicks while a large mesh is computed, and a new request cancels it', async () => {
   const { page, errors } = await openDemo();
-  // A gyroid of period 0.4 filling the box, at 256 cells: its surface passes through about a
-  // million cells, seconds of work even with every shortcut, so it is still running after the
-  // clicks below. (A union of balls stopped being enough once tapes were specialised per brick.)
-  await page.fill('#source', `f = 15.71;
-(sin(f * x) * cos(f * y) + sin(f * y) * cos(f * z) + sin(f * z) * cos(f * x)) / f`);
+  // 48 balls at 256 cells, each point also paying for 300 sines too small (1e-7 each) to move the
+  // surface and impossible to prune: seconds of work, so it is still running after the clicks
+  // below, while the meshes stay small (a surface filling the box made the software-rendered
+  // page crawl once the other pane showed it).
+  const balls = Array.from({ length: 48 }, (_, i) => {
+    const [a, z] = [i * 2.4, -0.8 + (1.6 * i) / 47];
+    return `translate(sphere(0.15), ${(0.6 * Math.cos(a)).toFixed(3)}, ${(0.6 * Math.sin(a)).toFixed(3)}, ${z.toFixed(3)})`;
+  });
+  const ripples = Array.from({ length: 300 }, (_, i) => `sin(${(1 + i / 7).toFixed(3)} * x + ${(2 + i / 11).toFixed(3)} * y + z)`);
+  await page.fill('#source', `union(${balls.join(',\n')}) + 0.0000001 * (${ripples.join(' + ')})`);
   await page.fill('#res', '256');
   await page.click('#run');
   // State and progress bar read in one go, so that they describe the same moment.
