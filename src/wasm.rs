@@ -176,6 +176,16 @@ impl Shape {
         vec![lo, hi]
     }
 
+    /// `[x0, y0, z0, x1, y1, z1]`: bounds to mesh the shape in, found from interval bounds alone:
+    /// the box its inside fits in (conservative, tight to about 1 % of its size) grown on every
+    /// side by `margin` (default 0.05) times its longest side. Throws when the inside is empty or
+    /// unbounded (a half-space, an unclipped gyroid), naming the open directions.
+    #[wasm_bindgen(js_name = autoBounds, unchecked_return_type = "[number, number, number, number, number, number]")]
+    pub fn auto_bounds(&self, margin: Option<f32>) -> Result<Vec<f32>, JsValue> {
+        let (lo, hi) = expr::extent::auto_bounds(&self.program, margin.unwrap_or(0.05)).map_err(js_error)?;
+        Ok(vec![lo.x, lo.y, lo.z, hi.x, hi.y, hi.z])
+    }
+
     /// Instructions on the compiled tape (after constant folding and sharing repeated parts).
     #[wasm_bindgen(getter, js_name = instructionCount)]
     pub fn instruction_count(&self) -> usize {

@@ -91,6 +91,26 @@ fn an_expression_is_meshed_in_the_default_or_given_bounds() {
 }
 
 #[test]
+fn fit_meshes_a_program_where_it_is_and_refuses_an_unbounded_one() {
+    // A torus far outside the default [-1, 1]³: fitted, it is whole (genus 1, closed).
+    let s = stats(&[
+        "mesh",
+        "--expr",
+        "translate(torus(2, 0.5), 5, -3, 1)",
+        "--fit",
+        "--method",
+        "emc",
+        "--res",
+        "48",
+    ]);
+    assert_eq!((s["euler"].as_i64(), s["closed_manifold"].as_bool()), (Some(0), Some(true)), "{s}");
+    assert!(s["dist_max"].as_f64().unwrap() < 0.05, "{s}");
+    let err = fails(&["mesh", "--expr", "z - 0.2", "--fit"]);
+    assert!(err.contains("unbounded along -x, -y, -z, +x, +y"), "{err}");
+    assert!(fails(&["mesh", "--expr", "sphere(1)", "--fit", "--bounds", "0,0,0,1,1,1"]).contains("--bounds"));
+}
+
+#[test]
 fn an_expression_file_is_meshed_and_its_errors_name_the_file() {
     let path = scratch("frame.isf");
     std::fs::write(&path, "// a frame\nsubtract(box(0.6, 0.6, 0.6), sphere(0.75))\n").unwrap();

@@ -81,6 +81,10 @@ struct MeshArgs {
     /// Mesh this box instead of the scene's own ([-1, 1]³ for expressions).
     #[arg(long, value_parser = list::<f32, 6>, value_name = "X0,Y0,Z0,X1,Y1,Z1", allow_hyphen_values = true)]
     bounds: Option<[f32; 6]>,
+    /// Fit the bounds to an --expr or --expr-file program: the box its inside fits in, found
+    /// from interval bounds, grown by 5 % of its longest side. Fails on an unbounded inside.
+    #[arg(long, conflicts_with_all = ["bounds", "scene", "grid", "mesh", "points"])]
+    fit: bool,
     /// Iso-level: points with value < iso are inside.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     iso: f32,
@@ -237,12 +241,21 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// Meshes a program in --bounds, or with --fit in bounds fitted to its inside.
+fn mesh_program(program: &expr::Program, args: &MeshArgs, request: &Request) -> Result<Output, Error> {
+    if !args.fit {
+        return pipeline::mesh_program(program, request);
+    }
+    let bounds = expr::extent::auto_bounds(program, 0.05)?;
+    pipeline::mesh_program(program, &Request { bounds: Some(bounds), ..request.clone() })
+}
+
 /// Meshes whichever input was given (clap makes sure it is exactly one).
 fn mesh_input(args: &MeshArgs, request: &Request) -> Result<Output, Error> {
     if let Some(name) = &args.scene {
         pipeline::mesh_scene(name, request)
     } else if let Some(text) = &args.expr {
-        pipeline::mesh_expr(text, request)
+        mesh_program(&expr::compile(text)?, args, request)
     } else if let Some(path) = &args.expr_file {
         let text = std::fs::read_to_string(path).map_err(|e| io_error(path, e))?;
         // Compiler style: file:line:column: message.
@@ -250,7 +263,7 @@ fn mesh_input(args: &MeshArgs, request: &Request) -> Result<Output, Error> {
             Error::Parse { .. } => Error::Io(format!("{}:{e}", path.display())),
             e => e,
         })?;
-        pipeline::mesh_program(&program, request)
+        mesh_program(&program, args, request)
     } else if let Some(path) = &args.grid {
         let dims = args.dims.ok_or_else(|| Error::InvalidOption("--grid needs --dims X,Y,Z".into()))?;
         let origin = args.origin.map_or(Vec3::ZERO, Vec3::from);

@@ -62,6 +62,7 @@ pub mod csg;
 mod csg_json;
 mod diag;
 mod eval;
+pub mod extent;
 mod field;
 mod graph;
 mod interval;
