@@ -99,6 +99,26 @@ pub fn scene_names() -> JsValue {
     arr.into()
 }
 
+/// The functions of the expression language, in the order of the docs: `{ name, signature,
+/// group, summary }` each, `group` one of "math", "shapes", "combinators", "transforms".
+#[wasm_bindgen(
+    js_name = languageReference,
+    unchecked_return_type = "{ name: string, signature: string, group: string, summary: string }[]"
+)]
+pub fn language_reference() -> Result<JsValue, JsValue> {
+    let arr = js_sys::Array::new();
+    for b in expr::Builtin::all() {
+        let entry = js_sys::Object::new();
+        for (key, value) in
+            [("name", b.name()), ("signature", b.signature()), ("group", b.group()), ("summary", b.summary())]
+        {
+            js_sys::Reflect::set(&entry, &key.into(), &value.into())?;
+        }
+        arr.push(&entry);
+    }
+    Ok(arr.into())
+}
+
 /// A built-in scene's program in the expression language (for an editor: change it, then
 /// `meshExpr` it with `{ bounds: sceneBounds(name) }`). Throws on unknown names.
 #[wasm_bindgen(js_name = sceneSource)]

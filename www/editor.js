@@ -1,6 +1,6 @@
 // The program editor: a textarea, checked as you type by compiling on the main thread (compiling
 // takes well under a millisecond; meshing is what goes to the workers), with a parse error shown
-// at its line and column, under the text it is about.
+// at its line and column, under the text it is about, and whole (it wraps at the editor's edge).
 
 /** Parses the library's error text, `line:column: message` then the line and a caret. */
 export function parseError(message) {
@@ -9,15 +9,19 @@ export function parseError(message) {
 }
 
 export class Editor {
-  constructor(textarea, errorBox, compile) {
+  /** `onEdit()` is called after each edit a person makes (not after `replace`). */
+  constructor(textarea, errorBox, compile, onEdit = () => {}) {
     this.textarea = textarea;
     this.errorBox = errorBox;
     this.compile = compile;
     this.error = null;
+    this.replacing = false;
     let timer = 0;
     textarea.addEventListener('input', () => {
+      if (this.replacing) return;
       clearTimeout(timer);
       timer = setTimeout(() => this.check(), 200);
+      onEdit();
     });
     textarea.addEventListener('scroll', () => this.place());
   }
@@ -28,6 +32,26 @@ export class Editor {
 
   set text(value) {
     this.textarea.value = value;
+    this.check();
+  }
+
+  /**
+   * Replaces the whole text as one edit on the browser's undo stack, so that Ctrl+Z in the editor
+   * brings back what was there (a plain `value =` would clear the stack). Focus goes back where
+   * it was.
+   */
+  replace(value) {
+    const t = this.textarea;
+    const focused = document.activeElement;
+    this.replacing = true;
+    t.focus();
+    t.select();
+    const inserted = document.execCommand('insertText', false, value);
+    this.replacing = false;
+    if (!inserted || t.value !== value) t.value = value;
+    t.setSelectionRange(0, 0);
+    t.scrollTop = 0;
+    if (focused && focused !== t && typeof focused.focus === 'function') focused.focus();
     this.check();
   }
 
@@ -61,7 +85,10 @@ export class Editor {
     box.dataset.column = String(at?.column ?? 0);
     box.textContent = at ? `${line}:${at.column}: ${at.text}` : this.error;
     box.style.top = `${parseFloat(style.paddingTop) + line * lineHeight - this.textarea.scrollTop + 2}px`;
-    box.style.left = `${parseFloat(style.paddingLeft) + Math.max((at?.column ?? 1) - 1, 0) * charWidth - this.textarea.scrollLeft}px`;
+    // The box spans the editor and wraps (a long message stays readable); its arrow points at
+    // the column.
+    const x = parseFloat(style.paddingLeft) + Math.max((at?.column ?? 1) - 1, 0) * charWidth - this.textarea.scrollLeft;
+    box.style.setProperty('--caret', `${Math.min(Math.max(x, 0), this.textarea.clientWidth - 8)}px`);
   }
 }
 

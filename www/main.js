@@ -1,39 +1,100 @@
 // The demo: a program in the expression language (typed, or loaded from the scene gallery) meshed
 // by two methods side by side, EMC on the left and DMC on the right by default, with their numbers.
-import init, { compile, sceneNames, sceneSource, sceneBounds } from './pkg/isoforge.js';
+// The page keeps its state (local storage, and the address bar as a link to share), re-meshes as
+// you type, and draws only when something changed.
+import init, { compile, sceneNames, sceneSource, sceneBounds, languageReference } from './pkg/isoforge.js';
 import * as THREE from 'three';
 import { Editor } from './editor.js';
 import { Pane } from './pane.js';
+import * as session from './session.js';
+import { showReference } from './reference.js';
 
 const $ = (id) => document.getElementById(id);
+const DEFAULT_SCENE = 'cube_minus_sphere';
+/** Options kept in the session and the link, by input id. */
+const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth'];
+const CHECKS = ['auto-bounds', 'live', 'wireframe', 'features', 'normals', 'bad'];
 
 await init();
-const editor = new Editor($('source'), $('editor-error'), compile);
+
+let drawPending = false;
+/** Draws both views at the next frame, once however many changes asked. */
+const requestRender = () => {
+  if (drawPending) return;
+  drawPending = true;
+  requestAnimationFrame(() => {
+    drawPending = false;
+    for (const p of panes) p.render();
+  });
+};
+
+let scene = null;
+let liveTimer = 0;
+const editor = new Editor($('source'), $('editor-error'), compile, () => {
+  scene = null;
+  remember();
+  if ($('live').checked) {
+    clearTimeout(liveTimer);
+    liveTimer = setTimeout(() => { if (!editor.check()) run(); }, 500);
+  }
+});
 const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
 const target = new THREE.Vector3();
+const fileName = () => scene ?? 'isoforge-program';
 const panes = [['emc', 0x4f86c6], ['dmc', 0x5c9e6e]].map(([method, color]) => {
   const root = $('pane-template').content.firstElementChild.cloneNode(true);
   root.dataset.side = method === 'emc' ? 'left' : 'right';
   $('panes').append(root);
-  return new Pane(root, { camera, target, method, color });
+  const onWayOut = (res) => { $('res').value = String(res); syncSlider(); run(); };
+  return new Pane(root, { camera, target, method, color, onChange: requestRender, onWayOut, fileName });
 });
-const render = () => {
-  for (const p of panes) { p.controls.update(); p.render(); }
-};
-let bounds = [-1, -1, -1, 1, 1, 1];
 
-function frame(b) {
-  const lo = new THREE.Vector3(b[0], b[1], b[2]);
-  const hi = new THREE.Vector3(b[3], b[4], b[5]);
+/** Points the shared camera at the box `lo`..`hi` (THREE.Vector3s) from the usual side. */
+function frame(lo, hi) {
   target.copy(lo).add(hi).multiplyScalar(0.5);
-  const r = hi.distanceTo(lo) / 2;
+  const r = Math.max(hi.distanceTo(lo) / 2, 1e-3);
   camera.position.copy(target).add(new THREE.Vector3(0.75, 0.55, 0.9).multiplyScalar(r * 1.6));
   camera.near = r / 100;
   camera.far = r * 20;
+  for (const p of panes) p.controls.update();
+  requestRender();
+}
+
+const frameBounds = (b) => frame(new THREE.Vector3(b[0], b[1], b[2]), new THREE.Vector3(b[3], b[4], b[5]));
+
+/** Frames what the panes show (or the bounds, before anything is shown). */
+function fitView() {
+  const box = new THREE.Box3();
+  for (const p of panes) { const b = p.box(); if (b) box.union(b); }
+  if (box.isEmpty()) frameBounds(readBounds() ?? [-1, -1, -1, 1, 1, 1]);
+  else frame(box.min, box.max);
+}
+
+/** The bounds field as six numbers with each low below its high, or null. */
+function readBounds() {
+  const b = $('bounds').value.trim().split(/[\s,]+/).map(Number);
+  const ok = b.length === 6 && b.every(Number.isFinite) && b[0] < b[3] && b[1] < b[4] && b[2] < b[5];
+  return ok ? b : null;
+}
+
+const showBounds = (b) => { $('bounds').value = b.map((v) => +v.toPrecision(4)).join(' '); };
+
+/** Fits the bounds field to the program's inside; returns an error message or null. */
+function fitBounds() {
+  let shape;
+  try {
+    shape = compile(editor.text);
+    showBounds(shape.autoBounds());
+    return null;
+  } catch (e) {
+    return String(e.message ?? e);
+  } finally {
+    shape?.free();
+  }
 }
 
 /** Options for one pane's method: grid methods take a resolution, DMC a tolerance and depth. */
-function options(method) {
+function options(method, bounds) {
   const common = { bounds, surfaceError: true };
   if (method === 'dmc') {
     return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
@@ -43,29 +104,101 @@ function options(method) {
   return grid;
 }
 
+function setStatus(state, text) {
+  $('status').textContent = text;
+  $('status').dataset.state = state;
+}
+
 async function run(event) {
   event?.preventDefault();
-  const status = $('status');
+  clearTimeout(liveTimer);
   if (editor.check()) {
-    status.textContent = 'fix the program first';
-    status.dataset.state = 'error';
+    setStatus('error', 'fix the program first');
     return;
   }
-  status.textContent = 'meshing…';
-  status.dataset.state = 'busy';
-  await Promise.all(panes.map((p) => p.mesh(editor.text, options(p.method))));
-  if (panes.every((p) => p.root.dataset.state !== 'busy')) {
-    status.textContent = '';
-    status.dataset.state = 'done';
+  let note = '';
+  if ($('auto-bounds').checked) {
+    const before = $('bounds').value;
+    const error = fitBounds();
+    if (error) note = `bounds not fitted: ${error}`;
+    else if ($('bounds').value !== before) frameBounds(readBounds());
+  }
+  const bounds = readBounds();
+  if (!bounds) {
+    setStatus('error', 'bounds: give six numbers x0 y0 z0 x1 y1 z1, each low below its high');
+    return;
+  }
+  remember();
+  setStatus('busy', 'meshing…');
+  await Promise.all(panes.map((p) => p.mesh(editor.text, options(p.method, bounds))));
+  if (panes.every((p) => p.root.dataset.state !== 'busy')) setStatus(note ? 'error' : 'done', note);
+}
+
+function stop() {
+  clearTimeout(liveTimer);
+  for (const p of panes) p.cancel();
+}
+
+/** The page's state, as saved and shared. */
+function collect() {
+  const s = { program: editor.text, scene, methods: panes.map((p) => p.method) };
+  for (const id of FIELDS) s[id] = $(id).value;
+  for (const id of CHECKS) s[id] = $(id).checked;
+  return s;
+}
+
+/** Saves the state and puts it in the address bar (replacing, so Back still leaves the page). */
+function remember() {
+  const s = collect();
+  session.save(s);
+  history.replaceState(null, '', session.shareUrl(s));
+}
+
+function apply(s) {
+  for (const id of FIELDS) if (typeof s[id] === 'string') $(id).value = s[id];
+  for (const id of CHECKS) if (typeof s[id] === 'boolean') $(id).checked = s[id];
+  (s.methods ?? []).forEach((m, i) => { if (panes[i] && [...panes[i].methodSelect.options].some((o) => o.value === m)) panes[i].methodSelect.value = m; });
+  scene = typeof s.scene === 'string' && sceneNames().includes(s.scene) ? s.scene : null;
+  editor.text = s.program;
+  for (const p of panes) for (const name of ['wireframe', 'features', 'normals', 'bad']) p.toggle(name, $(name).checked);
+  syncSlider();
+  showAngles();
+  markGallery();
+}
+
+function markGallery() {
+  for (const b of $('gallery').children) b.setAttribute('aria-pressed', String(b.dataset.scene === scene));
+}
+
+/** Loads a gallery scene: its program (undoable in the editor), its bounds, and a view of them. */
+function load(name) {
+  scene = name;
+  markGallery();
+  const bounds = sceneBounds(name);
+  showBounds(bounds);
+  $('auto-bounds').checked = false;
+  editor.replace(sceneSource(name));
+  frameBounds(bounds);
+  run();
+}
+
+const syncSlider = () => { $('res-slider').value = $('res').value; };
+
+/** The angles the cosines θ and φ stand for, beside them. */
+function showAngles() {
+  for (const id of ['theta', 'phi']) {
+    const c = Number($(id).value);
+    $(`${id}-deg`).textContent = Math.abs(c) <= 1 ? `= ${((Math.acos(c) * 180) / Math.PI).toFixed(1)}°` : '';
   }
 }
 
-function load(name) {
-  for (const b of $('gallery').children) b.setAttribute('aria-pressed', String(b.dataset.scene === name));
-  bounds = sceneBounds(name);
-  editor.text = sceneSource(name);
-  frame(bounds);
-  run();
+/** Re-meshes after an option changed, when live updates are on. */
+function optionChanged() {
+  remember();
+  if ($('live').checked) {
+    clearTimeout(liveTimer);
+    liveTimer = setTimeout(run, 300);
+  }
 }
 
 for (const name of sceneNames()) {
@@ -74,16 +207,58 @@ for (const name of sceneNames()) {
   button.addEventListener('click', () => load(name));
   $('gallery').append(button);
 }
-$('controls').addEventListener('submit', run);
-$('source').addEventListener('keydown', (e) => {
-  if (e.key === 'Enter' && (e.ctrlKey || e.metaKey)) run(e);
+showReference($('reference-list'), languageReference(), (text) => {
+  const t = $('source');
+  t.focus();
+  document.execCommand('insertText', false, text);
 });
-for (const p of panes) p.methodSelect.addEventListener('change', () => p.mesh(editor.text, options(p.method)));
-for (const name of ['wireframe', 'features', 'normals']) {
-  $(name).addEventListener('change', (e) => { for (const p of panes) p.toggle(name, e.target.checked); render(); });
+$('controls').addEventListener('submit', run);
+$('stop').addEventListener('click', stop);
+$('fit-view').addEventListener('click', fitView);
+$('fit-bounds').addEventListener('click', () => {
+  const error = fitBounds();
+  if (error) { setStatus('error', error); return; }
+  frameBounds(readBounds());
+  optionChanged();
+});
+$('share').addEventListener('click', async () => {
+  remember();
+  const url = session.shareUrl(collect());
+  Object.assign($('share-url'), { value: url, hidden: false }).select();
+  try {
+    await navigator.clipboard.writeText(url);
+    setStatus('done', 'link copied');
+  } catch {
+    setStatus('done', 'copy the link above');
+  }
+});
+$('res-slider').addEventListener('input', () => { $('res').value = $('res-slider').value; });
+$('res-slider').addEventListener('change', optionChanged);
+for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds']) {
+  $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }
-new ResizeObserver(render).observe($('panes'));
-// Draw every frame while anything may change (results arrive asynchronously); cheap for two views.
-const loop = () => { render(); requestAnimationFrame(loop); };
-requestAnimationFrame(loop);
-load('cube_minus_sphere');
+for (const id of ['theta', 'phi']) $(id).addEventListener('input', showAngles);
+$('auto-bounds').addEventListener('change', optionChanged);
+$('live').addEventListener('change', remember);
+for (const p of panes) p.methodSelect.addEventListener('change', () => { remember(); run(); });
+for (const name of ['wireframe', 'features', 'normals', 'bad']) {
+  $(name).addEventListener('change', (e) => { for (const p of panes) p.toggle(name, e.target.checked); remember(); });
+}
+document.addEventListener('keydown', (e) => {
+  if (e.key === 'Enter' && (e.ctrlKey || e.metaKey)) run(e);
+  else if (e.key === 'Escape') stop();
+  else if ((e.key === 'f' || e.key === 'F') && !e.ctrlKey && !e.metaKey && !(e.target instanceof HTMLInputElement || e.target instanceof HTMLTextAreaElement)) fitView();
+});
+matchMedia('(prefers-color-scheme: dark)').addEventListener('change', requestRender);
+
+showAngles();
+// A link wins over the last visit; a first visit gets the default scene.
+const start = session.fromHash(location.hash) ?? session.restore();
+if (start) {
+  apply(start);
+  const b = readBounds();
+  if (b) frameBounds(b);
+  run();
+} else {
+  load(DEFAULT_SCENE);
+}

@@ -75,48 +75,64 @@ impl fmt::Display for Arity {
 
 use Builtin as B;
 
-/// Name, signature as shown in errors, and builtin. The order is the order of the docs.
-const TABLE: &[(&str, &str, Builtin)] = &[
-    ("sin", "sin(a)", B::Sin),
-    ("cos", "cos(a)", B::Cos),
-    ("tan", "tan(a)", B::Tan),
-    ("asin", "asin(a)", B::Asin),
-    ("acos", "acos(a)", B::Acos),
-    ("atan", "atan(a)", B::Atan),
-    ("atan2", "atan2(y, x)", B::Atan2),
-    ("exp", "exp(a)", B::Exp),
-    ("log", "log(a)", B::Log),
-    ("sqrt", "sqrt(a)", B::Sqrt),
-    ("abs", "abs(a)", B::Abs),
-    ("floor", "floor(a)", B::Floor),
-    ("min", "min(a, …)", B::Min),
-    ("max", "max(a, …)", B::Max),
-    ("pow", "pow(a, b)", B::Pow),
-    ("clamp", "clamp(a, lo, hi)", B::Clamp),
-    ("mix", "mix(a, b, t)", B::Mix),
-    ("length", "length(a, …)", B::Length),
-    ("sphere", "sphere(r)", B::Sphere),
-    ("box", "box(hx, hy, hz)", B::Box),
-    ("rounded_box", "rounded_box(hx, hy, hz, r)", B::RoundedBox),
-    ("cylinder", "cylinder(r, h)", B::Cylinder),
-    ("cone", "cone(r, h)", B::Cone),
-    ("torus", "torus(R, r)", B::Torus),
-    ("capsule", "capsule(ax, ay, az, bx, by, bz, r)", B::Capsule),
-    ("plane", "plane(nx, ny, nz, d)", B::Plane),
-    ("union", "union(a, …)", B::Union),
-    ("intersect", "intersect(a, …)", B::Intersect),
-    ("subtract", "subtract(a, b)", B::Subtract),
-    ("smooth_union", "smooth_union(a, b, k)", B::SmoothUnion),
-    ("smooth_intersect", "smooth_intersect(a, b, k)", B::SmoothIntersect),
-    ("smooth_subtract", "smooth_subtract(a, b, k)", B::SmoothSubtract),
-    ("shell", "shell(a, t)", B::Shell),
-    ("offset", "offset(a, d)", B::Offset),
-    ("translate", "translate(shape, dx, dy, dz)", B::Translate),
-    ("rotate", "rotate(shape, ax, ay, az, degrees)", B::Rotate),
-    ("scale", "scale(shape, s)", B::Scale),
-    ("mirror_x", "mirror_x(shape)", B::MirrorX),
-    ("mirror_y", "mirror_y(shape)", B::MirrorY),
-    ("mirror_z", "mirror_z(shape)", B::MirrorZ),
+/// Name, signature as shown in errors, builtin, and what it is (for the page's language
+/// reference). The order is the order of the docs.
+const TABLE: &[(&str, &str, Builtin, &str)] = &[
+    ("sin", "sin(a)", B::Sin, "sine (radians)"),
+    ("cos", "cos(a)", B::Cos, "cosine (radians)"),
+    ("tan", "tan(a)", B::Tan, "tangent (radians)"),
+    ("asin", "asin(a)", B::Asin, "arc sine"),
+    ("acos", "acos(a)", B::Acos, "arc cosine"),
+    ("atan", "atan(a)", B::Atan, "arc tangent"),
+    ("atan2", "atan2(y, x)", B::Atan2, "angle of the point (x, y), in radians"),
+    ("exp", "exp(a)", B::Exp, "e to the power a"),
+    ("log", "log(a)", B::Log, "natural logarithm"),
+    ("sqrt", "sqrt(a)", B::Sqrt, "square root"),
+    ("abs", "abs(a)", B::Abs, "absolute value"),
+    ("floor", "floor(a)", B::Floor, "largest integer ≤ a"),
+    ("min", "min(a, …)", B::Min, "smallest argument"),
+    ("max", "max(a, …)", B::Max, "largest argument"),
+    ("pow", "pow(a, b)", B::Pow, "a to the power b"),
+    ("clamp", "clamp(a, lo, hi)", B::Clamp, "a limited to [lo, hi]"),
+    ("mix", "mix(a, b, t)", B::Mix, "a + (b − a)·t"),
+    ("length", "length(a, …)", B::Length, "√(a² + …): length(x, y, z) is the distance to the origin"),
+    ("sphere", "sphere(r)", B::Sphere, "ball of radius r at the origin"),
+    ("box", "box(hx, hy, hz)", B::Box, "box with half extents hx, hy, hz"),
+    (
+        "rounded_box",
+        "rounded_box(hx, hy, hz, r)",
+        B::RoundedBox,
+        "box with half extents h, edges rounded by r",
+    ),
+    ("cylinder", "cylinder(r, h)", B::Cylinder, "radius r about the z axis, from z = −h to h"),
+    ("cone", "cone(r, h)", B::Cone, "base radius r in the plane z = 0, apex at z = h"),
+    ("torus", "torus(R, r)", B::Torus, "ring of radius R about the z axis, tube radius r"),
+    ("capsule", "capsule(ax, ay, az, bx, by, bz, r)", B::Capsule, "segment from a to b thickened by r"),
+    ("plane", "plane(nx, ny, nz, d)", B::Plane, "half-space n·p ≤ d (n normalised)"),
+    ("union", "union(a, …)", B::Union, "inside any (min)"),
+    ("intersect", "intersect(a, …)", B::Intersect, "inside all (max)"),
+    ("subtract", "subtract(a, b)", B::Subtract, "inside a, outside b"),
+    ("smooth_union", "smooth_union(a, b, k)", B::SmoothUnion, "union blended over width k"),
+    (
+        "smooth_intersect",
+        "smooth_intersect(a, b, k)",
+        B::SmoothIntersect,
+        "intersection blended over width k",
+    ),
+    ("smooth_subtract", "smooth_subtract(a, b, k)", B::SmoothSubtract, "difference blended over width k"),
+    ("shell", "shell(a, t)", B::Shell, "hollow wall of thickness 2t around the surface: |a| − t"),
+    ("offset", "offset(a, d)", B::Offset, "grown by d: a − d"),
+    ("translate", "translate(shape, dx, dy, dz)", B::Translate, "moved by (dx, dy, dz)"),
+    (
+        "rotate",
+        "rotate(shape, ax, ay, az, degrees)",
+        B::Rotate,
+        "turned by degrees about the axis (ax, ay, az) through the origin (right-hand rule)",
+    ),
+    ("scale", "scale(shape, s)", B::Scale, "scaled by s about the origin"),
+    ("mirror_x", "mirror_x(shape)", B::MirrorX, "mirrored across x = 0: shape at (|x|, y, z)"),
+    ("mirror_y", "mirror_y(shape)", B::MirrorY, "mirrored across y = 0"),
+    ("mirror_z", "mirror_z(shape)", B::MirrorZ, "mirrored across z = 0"),
 ];
 
 impl Builtin {
@@ -128,7 +144,7 @@ impl Builtin {
         TABLE.iter().map(|e| e.0)
     }
 
-    fn entry(self) -> &'static (&'static str, &'static str, Builtin) {
+    fn entry(self) -> &'static (&'static str, &'static str, Builtin, &'static str) {
         // A variant missing from the table could never be parsed; the fallback only avoids a panic.
         TABLE.iter().find(|e| e.2 == self).unwrap_or(&TABLE[0])
     }
@@ -139,6 +155,35 @@ impl Builtin {
 
     pub fn signature(self) -> &'static str {
         self.entry().1
+    }
+
+    /// What the function is, in a few words.
+    pub fn summary(self) -> &'static str {
+        self.entry().3
+    }
+
+    /// Which part of the language reference it belongs to.
+    pub fn group(self) -> &'static str {
+        match self {
+            B::Sphere | B::Box | B::RoundedBox | B::Cylinder | B::Cone | B::Torus | B::Capsule | B::Plane => {
+                "shapes"
+            }
+            B::Union
+            | B::Intersect
+            | B::Subtract
+            | B::SmoothUnion
+            | B::SmoothIntersect
+            | B::SmoothSubtract
+            | B::Shell
+            | B::Offset => "combinators",
+            _ if self.is_transform() => "transforms",
+            _ => "math",
+        }
+    }
+
+    /// Every builtin, in the order of the docs.
+    pub fn all() -> impl Iterator<Item = Builtin> {
+        TABLE.iter().map(|e| e.2)
     }
 
     pub fn arity(self) -> Arity {
@@ -161,7 +206,8 @@ mod tests {
 
     #[test]
     fn every_builtin_round_trips_through_its_name() {
-        for &(name, _, b) in TABLE {
+        for &(name, _, b, summary) in TABLE {
+            assert!(!summary.is_empty());
             assert_eq!(Builtin::lookup(name), Some(b));
             assert_eq!(b.name(), name);
         }

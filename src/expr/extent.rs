@@ -63,7 +63,8 @@ impl Ord for Cell {
 
 /// Whether interval bounds leave room for an inside point in the box (NaN bounds do).
 fn may_be_inside(program: &Program, lo: Vec3, hi: Vec3) -> bool {
-    !(program.eval_interval(lo, hi).0 > 0.0)
+    let low = program.eval_interval(lo, hi).0;
+    low <= 0.0 || low.is_nan()
 }
 
 /// How far along `axis` (`sign` = +1 or -1) the inside can reach within the box `lo..hi`, to

@@ -2,57 +2,10 @@
 // page served on localhost. Run by scripts/test.sh after the wasm package is built.
 import { test, before, after, afterEach } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, canvasColours } from '../../scripts/browser.mjs';
+import { canvasColours } from '../../scripts/browser.mjs';
+import { demoSuite, settled, stat, count, LEFT, RIGHT } from './demo-page.mjs';
 
-let server;
-let browser;
-
-before(async () => {
-  server = await serve('www');
-  browser = await launch();
-});
-
-after(async () => {
-  await browser?.close();
-  server?.close();
-});
-
-// A failed test must not leave its page meshing in the background and slow down the next ones.
-const open = new Set();
-afterEach(async () => {
-  for (const page of open) await page.close();
-  open.clear();
-});
-
-const LEFT = '.pane[data-side="left"]';
-const RIGHT = '.pane[data-side="right"]';
-
-/** Waits until neither pane is meshing; fails on a pane error unless `allowErrors`. */
-async function settled(page, { allowErrors = false } = {}) {
-  await page.waitForFunction(() => {
-    const panes = [...document.querySelectorAll('.pane')];
-    return panes.length === 2 && panes.every((p) => p.dataset.state === 'done' || p.dataset.state === 'error');
-  }, null, { timeout: 120_000 });
-  if (!allowErrors) {
-    for (const side of [LEFT, RIGHT]) {
-      const state = await page.$eval(side, (p) => [p.dataset.state, p.querySelector('.state').textContent]);
-      assert.equal(state[0], 'done', `${side}: ${state[1]}`);
-    }
-  }
-}
-
-async function openDemo() {
-  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
-  open.add(page);
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  await page.goto(server.url);
-  await settled(page);
-  return { page, errors };
-}
-
-const stat = (page, side, key) => page.$eval(`${side} .stats tr[data-key="${key}"] td:last-child`, (td) => td.textContent);
-const count = async (page, side, key) => Number((await stat(page, side, key)).replace(/,/g, ''));
+const { openDemo } = demoSuite({ before, after, afterEach });
 
 test('both viewports mesh the default scene, EMC and DMC, as closed manifolds with their numbers', async () => {
   const { page, errors } = await openDemo();
@@ -188,13 +141,24 @@ test('the page answers clicks while a large mesh is computed, and a new request 
   await page.close();
 });
 
-test('a too-large request gets a clear message, not a dead tab', async () => {
+test('a too-large request gets a clear message and a way out, and the old mesh goes', async () => {
   const { page } = await openDemo();
   await page.fill('#res', '2048');
   await page.click('#run');
   await settled(page, { allowErrors: true });
   assert.equal(await page.$eval(LEFT, (p) => p.dataset.state), 'error');
-  assert.match(await page.textContent(`${LEFT} .state`), /larger than the limit/);
+  assert.match(await page.textContent(`${LEFT} .state`), /2048 cells per side is 8,589,934,592 cells, more than this page meshes/);
+  // No stale mesh or numbers left up to pass for the answer.
+  assert.equal(await page.$$eval(`${LEFT} .stats tr`, (rows) => rows.length), 0);
+  const way = await page.textContent(`${LEFT} .way-out`);
+  const res = Number(/Mesh at (\d+)/.exec(way)[1]);
+  assert.ok(res > 48 && res ** 3 <= 72_000_000, way);
+  // The way out re-meshes at the largest resolution that fits (a shallower one keeps it quick here).
+  await page.$eval(`${LEFT} .way-out`, (b) => { b.dataset.res = '40'; });
+  await page.click(`${LEFT} .way-out`);
+  await settled(page);
+  assert.equal(await page.inputValue('#res'), '40');
+  assert.equal(await stat(page, LEFT, 'Euler characteristic'), '-8');
   await page.close();
 });
 
@@ -205,7 +169,7 @@ test('the current mesh downloads as OBJ, STL, PLY and GLB', async () => {
   for (const format of ['obj', 'stl', 'ply', 'glb']) {
     await page.selectOption(`${LEFT} .format`, format);
     const [download] = await Promise.all([page.waitForEvent('download'), page.click(`${LEFT} .download`)]);
-    assert.equal(download.suggestedFilename(), `isoforge-emc.${format}`);
+    assert.equal(download.suggestedFilename(), `cube_minus_sphere-emc.${format}`);
     const chunks = [];
     for await (const chunk of await download.createReadStream()) chunks.push(chunk);
     const bytes = Buffer.concat(chunks);
