@@ -12,6 +12,9 @@ cargo fmt --all -- --check
 log "clippy (native)"
 cargo clippy --all-targets -- -D warnings
 
+log "cargo doc (no warnings)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+
 log "clippy (wasm32)"
 wasm_cargo clippy --lib --tests --no-default-features -- -D warnings
 

@@ -1,5 +1,20 @@
 //! isoforge: feature-preserving isosurface extraction for Rust and the browser.
 //!
+//! # Start here
+//! [`pipeline`] turns an input (a program in the [`expr`] language, a CSG tree, a sampled grid, a
+//! triangle mesh, a point cloud) and a [`pipeline::Request`] (method, resolution, bounds, options)
+//! into a mesh and its [`stats`]. The README's quick start, tested here:
+//!
+//! ```
+//! # fn main() -> Result<(), isoforge::Error> {
+//! use isoforge::pipeline::{mesh_expr, Method, Request};
+//! let request = Request { method: Method::Emc, res: 48, ..Request::default() };
+//! let out = mesh_expr("subtract(box(0.6, 0.6, 0.6), sphere(0.75))", &request)?;
+//! assert!(out.stats.closed_manifold && out.stats.euler == -8);
+//! isoforge::mesh::export::write_by_extension(&out.mesh, &std::env::temp_dir().join("frame.glb"))?;
+//! # Ok(()) }
+//! ```
+//!
 //! The crate is organised in rooms, each owning one idea:
 //! - [`grid`]: where samples live (bounds, dimensions, index → world mapping, size caps).
 //! - [`field`]: what is sampled (the [`field::Field`] trait, closures, sampled volumes).

@@ -1,7 +1,7 @@
 //! From a request (method, resolution, options) to a mesh and its stats: the one path the CLI, the
 //! wasm bindings and the benches share, so the three can never disagree about what a request means.
 //! Fields (scenes, programs, functions) and sampled volumes are meshed here; triangle meshes and
-//! point clouds in [`inputs`].
+//! point clouds in `pipeline/inputs.rs`.
 
 use crate::dmc::{self, DmcOptions, DmcStats};
 use crate::emc::{self, EmcMesh, EmcOptions};

@@ -347,7 +347,7 @@ mod tests {
         // of samples sees the cone, so that direction's singular value (1e-6 of the largest) falls
         // under the cutoff: the minimiser keeps the reference's height, although the edge lies in
         // the (grown) box and fits exactly. Following such weak directions was measured and not
-        // kept (README, "The rounded room"): it took the rounded room from 1048 to 1036 triangles
+        // kept: it took the rounded room from 1048 to 1036 triangles
         // but put the rotated box's outside vertices on its edges (depth 5: 1454 triangles, 0.0086,
         // normal p95 0.2° became 1684, 0.0136, 44.9°).
         let (lo, hi) = (Vec3::new(0.021, 0.8085, -0.504), Vec3::new(0.2835, 1.071, -0.2415));

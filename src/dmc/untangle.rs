@@ -46,7 +46,7 @@ pub fn offending_triangles(mesh: &Mesh) -> Vec<u32> {
 }
 
 /// Moves the vertices of the surface leaves around `cells` (dual cells, by their eight keys)
-/// toward their centres by one more of [`STEPS`] (`moves` counts each vertex's moves and
+/// toward their centres by one more of `STEPS` (`moves` counts each vertex's moves and
 /// `origins` keeps where the QEF put it); a merged leaf whose vertex has moved once already is
 /// un-merged instead, back to the eight leaves it was made of (the state before that merge, whose
 /// topology is the same, see [`super::safety`]). Returns (vertices moved, leaves un-merged).

@@ -62,7 +62,7 @@ pub struct EmcOptions {
     /// Triangulate the components without a feature point by the per-cell polygon rules of
     /// [`crate::mcq`] (cut off sharp corners, inner vertex in long or uneven polygons, otherwise
     /// split the largest angle) instead of MC's table; `None` (default) keeps MC's triangles.
-    /// Feature fans are unchanged. No vertex snapping (see the README).
+    /// Feature fans are unchanged. No vertex snapping.
     pub better_triangles: Option<PolygonRules>,
     /// Move edge points onto curved creases by sampling each sheet again next to the solved point
     /// (see [`resample`]), where the input can be sampled off the grid edges (functions, with

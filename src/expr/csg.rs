@@ -120,7 +120,7 @@ impl CsgNode {
         })
     }
 
-    /// Why this node's own parameters are out of range (see [`super::params::check`]), or `None`.
+    /// Why this node's own parameters are out of range (see `params::check`), or `None`.
     pub fn parameter_error(&self) -> Option<String> {
         let (f, shapes, numbers) = parts(self);
         let args: Vec<Option<f64>> =

@@ -1,7 +1,7 @@
 //! Marching Cubes with better triangles (issue 7, seed paper 004): the same vertices as
 //! [`crate::mc`], shared per grid edge by the same sweep, but each cell's polygon border from
-//! [`crate::tables::polygon_table`] is triangulated by the paper's rules ([`polygon`]) instead of
-//! the fixed table, after an optional vertex snapping step ([`snap`]) that removes the tiny edges
+//! [`crate::tables::polygon_table`] is triangulated by the paper's rules (`polygon.rs`) instead of
+//! the fixed table, after an optional vertex snapping step (`snap.rs`) that removes the tiny edges
 //! near grid points which no per-cell rule can fix.
 //!
 //! Always uses the default (fixed) case table: its polygons need no centre vertex, so the Marching
@@ -77,7 +77,7 @@ impl McqOptions {
     }
 }
 
-/// Default snapping distance in cells (see the README's measurements).
+/// Default snapping distance in cells (see docs/mcq.md's measurements).
 pub const DEFAULT_SNAP: f32 = 0.3;
 
 /// What a run did, besides the mesh.

@@ -127,7 +127,7 @@ pub struct MeshDistance<'a> {
 
 impl<'a> MeshDistance<'a> {
     /// `on_surface` is 1e-5 of the diagonal of `bounds`, a hundred times the tolerance of the
-    /// projections in [`crate::mesh::analysis::surface_error`].
+    /// projections in `mesh::analysis::surface_error`.
     pub fn new(mesh: &'a MeshBvh, bounds: (Vec3, Vec3)) -> MeshDistance<'a> {
         MeshDistance { mesh, on_surface: 1e-5 * (bounds.1 - bounds.0).length() }
     }

@@ -52,7 +52,7 @@ export interface MeshOptions {
   directed?: boolean;
   /**
    * EMC: triangulate cells without a sharp feature by MCQ's per-cell polygon rules instead of
-   * Marching Cubes' table (default false); feature fans are unchanged. See the README's measurements.
+   * Marching Cubes' table (default false); feature fans are unchanged. See docs/emc.md's measurements.
    */
   betterTriangles?: boolean;
   /**
@@ -178,7 +178,7 @@ export interface MeshResult {
 
 /**
  * A shape tree for meshCsg / compileCsg. Each node means the language function of the same name;
- * see the README's "Language" section. Unknown fields are an error.
+ * see docs/language.md. Unknown fields are an error.
  */
 export type CsgNode =
   | { op: "sphere"; radius: number }

@@ -92,6 +92,17 @@ test("the npm README's three.js example runs as written and draws the mesh", asy
   await page.close();
 });
 
+test("the README's JavaScript quick start runs as written and prints what its comment says", async () => {
+  const readme = readFileSync('README.md', 'utf8');
+  const quick = readme.slice(readme.indexOf('## Quick start'));
+  const example = quick.match(/```js\n([\s\S]*?)```/)[1];
+  const promised = /console\.log\(.*\/\/ (.*)$/m.exec(example)[1].trim();
+  const { page, errors, logged } = await modulePage('readme-quick-start.html', example);
+  assert.deepEqual(errors, []);
+  assert.equal(logged[0], promised);
+  await page.close();
+});
+
 test("three.js's own GLTFLoader reads exportMesh's GLB back to the same mesh", async () => {
   const { page, errors, logged } = await modulePage('gltf-loader.html', `
     import init, { meshScene, exportMesh } from 'isoforge';
