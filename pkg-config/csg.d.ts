@@ -16,10 +16,10 @@ export type { CsgNode };
 export type Vec3 = [number, number, number] | Float32Array | Float64Array;
 
 /** A shape or a plain CsgNode object. */
-export type ShapeLike = Shape | CsgNode;
+export type ShapeLike = CsgShape | CsgNode;
 
 /** An immutable CSG tree. */
-export class Shape {
+export class CsgShape {
   private constructor(node: CsgNode);
   /** The plain CsgNode object. */
   readonly node: CsgNode;
@@ -28,62 +28,65 @@ export class Shape {
   /** The JSON text of the tree. */
   toString(): string;
   /** `union(this, ...others)`: the minimum of the distances. */
-  union(...others: ShapeLike[]): Shape;
+  union(...others: ShapeLike[]): CsgShape;
   /** `intersect(this, ...others)`: the maximum of the distances. */
-  intersect(...others: ShapeLike[]): Shape;
+  intersect(...others: ShapeLike[]): CsgShape;
   /** `subtract(this, other)`: this with other cut away. */
-  subtract(other: ShapeLike): Shape;
+  subtract(other: ShapeLike): CsgShape;
   /** `smooth_union(this, other, k)`: union blended over a width k > 0. */
-  smoothUnion(other: ShapeLike, k: number): Shape;
+  smoothUnion(other: ShapeLike, k: number): CsgShape;
   /** `smooth_intersect(this, other, k)`: intersection blended over a width k > 0. */
-  smoothIntersect(other: ShapeLike, k: number): Shape;
+  smoothIntersect(other: ShapeLike, k: number): CsgShape;
   /** `smooth_subtract(this, other, k)`: subtraction blended over a width k > 0. */
-  smoothSubtract(other: ShapeLike, k: number): Shape;
+  smoothSubtract(other: ShapeLike, k: number): CsgShape;
   /** `shell(this, t)` = |this| - t: a hollow skin of thickness 2t around the surface. */
-  shell(thickness: number): Shape;
+  shell(thickness: number): CsgShape;
   /** `offset(this, d)` = this - d: grown by d (shrunk for d < 0). */
-  offset(distance: number): Shape;
+  offset(distance: number): CsgShape;
   /** `translate(this, dx, dy, dz)`: moved by the offset. */
-  translate(offset: Vec3): Shape;
+  translate(offset: Vec3): CsgShape;
   /** `rotate(this, ax, ay, az, degrees)`: turned about the axis through the origin (right-hand rule). */
-  rotate(axis: Vec3, degrees: number): Shape;
+  rotate(axis: Vec3, degrees: number): CsgShape;
   /** `scale(this, s)` = s·this(p/s): uniformly scaled about the origin. */
-  scale(factor: number): Shape;
+  scale(factor: number): CsgShape;
   /** `mirror_x(this)` = this(|x|, y, z): the x > 0 half mirrored onto x < 0. */
-  mirrorX(): Shape;
+  mirrorX(): CsgShape;
   /** `mirror_y(this)` = this(x, |y|, z). */
-  mirrorY(): Shape;
+  mirrorY(): CsgShape;
   /** `mirror_z(this)` = this(x, y, |z|). */
-  mirrorZ(): Shape;
+  mirrorZ(): CsgShape;
 }
 
 /** `sphere(r)`: centred at the origin. */
-export function sphere(radius: number): Shape;
+export function sphere(radius: number): CsgShape;
 /** `box(hx, hy, hz)`: centred at the origin, half extents along x, y, z. */
-export function box(hx: number, hy: number, hz: number): Shape;
+export function box(hx: number, hy: number, hz: number): CsgShape;
 /** `rounded_box(hx, hy, hz, r)`: outer half extents, edges rounded with radius r. */
-export function roundedBox(hx: number, hy: number, hz: number, radius: number): Shape;
+export function roundedBox(hx: number, hy: number, hz: number, radius: number): CsgShape;
 /** `cylinder(r, h)`: axis z, from z = -halfHeight to z = halfHeight. */
-export function cylinder(radius: number, halfHeight: number): Shape;
+export function cylinder(radius: number, halfHeight: number): CsgShape;
 /** `cone(r, h)`: base of radius r in the plane z = 0, apex at z = h. */
-export function cone(radius: number, height: number): Shape;
+export function cone(radius: number, height: number): CsgShape;
 /** `torus(R, r)`: around the z axis. */
-export function torus(major: number, minor: number): Shape;
+export function torus(major: number, minor: number): CsgShape;
 /** `capsule(ax, ay, az, bx, by, bz, r)`: the segment a–b thickened by r. */
-export function capsule(a: Vec3, b: Vec3, radius: number): Shape;
+export function capsule(a: Vec3, b: Vec3, radius: number): CsgShape;
 /** `plane(nx, ny, nz, d)` = n·p - d with n normalised: the half-space below the plane is inside. */
-export function plane(normal: Vec3, distance: number): Shape;
+export function plane(normal: Vec3, distance: number): CsgShape;
 /** `union(a, …)`: at least one shape. */
-export function union(...shapes: ShapeLike[]): Shape;
+export function union(...shapes: ShapeLike[]): CsgShape;
 /** `intersect(a, …)`: at least one shape. */
-export function intersect(...shapes: ShapeLike[]): Shape;
+export function intersect(...shapes: ShapeLike[]): CsgShape;
 /** `subtract(a, b)`: a with b cut away. */
-export function subtract(a: ShapeLike, b: ShapeLike): Shape;
+export function subtract(a: ShapeLike, b: ShapeLike): CsgShape;
 /** `smooth_union(a, b, k)`. */
-export function smoothUnion(a: ShapeLike, b: ShapeLike, k: number): Shape;
+export function smoothUnion(a: ShapeLike, b: ShapeLike, k: number): CsgShape;
 /** `smooth_intersect(a, b, k)`. */
-export function smoothIntersect(a: ShapeLike, b: ShapeLike, k: number): Shape;
+export function smoothIntersect(a: ShapeLike, b: ShapeLike, k: number): CsgShape;
 /** `smooth_subtract(a, b, k)`. */
-export function smoothSubtract(a: ShapeLike, b: ShapeLike, k: number): Shape;
+export function smoothSubtract(a: ShapeLike, b: ShapeLike, k: number): CsgShape;
 /** Wraps a CsgNode object or its JSON text so it can be chained. */
-export function fromJSON(node: CsgNode | string): Shape;
+export function fromJSON(node: CsgNode | string): CsgShape;
+
+/** @deprecated The old name of CsgShape (it clashed with the compiled `Shape` of "isoforge"). */
+export { CsgShape as Shape };

@@ -16,13 +16,13 @@ const num = (x, what) => {
 };
 
 const node = (x, what) => {
-  if (x instanceof Shape) return x.node;
+  if (x instanceof CsgShape) return x.node;
   if (x && typeof x === 'object' && typeof x.op === 'string') return x;
-  throw new TypeError(`${what} must be a Shape or a CsgNode object`);
+  throw new TypeError(`${what} must be a CsgShape or a CsgNode object`);
 };
 
 /** An immutable CSG tree; build one with the shape functions below. */
-export class Shape {
+export class CsgShape {
   constructor(csgNode) {
     this.node = csgNode;
     Object.freeze(this);
@@ -63,81 +63,84 @@ export class Shape {
   }
 
   shell(thickness) {
-    return new Shape({ op: 'shell', shape: this.node, thickness: num(thickness, 'shell thickness') });
+    return new CsgShape({ op: 'shell', shape: this.node, thickness: num(thickness, 'shell thickness') });
   }
 
   offset(distance) {
-    return new Shape({ op: 'offset', shape: this.node, distance: num(distance, 'offset distance') });
+    return new CsgShape({ op: 'offset', shape: this.node, distance: num(distance, 'offset distance') });
   }
 
   translate(offset) {
-    return new Shape({ op: 'translate', shape: this.node, offset: vec3(offset, 'translate offset') });
+    return new CsgShape({ op: 'translate', shape: this.node, offset: vec3(offset, 'translate offset') });
   }
 
   rotate(axis, degrees) {
-    return new Shape({ op: 'rotate', shape: this.node, axis: vec3(axis, 'rotate axis'), degrees: num(degrees, 'rotate degrees') });
+    return new CsgShape({ op: 'rotate', shape: this.node, axis: vec3(axis, 'rotate axis'), degrees: num(degrees, 'rotate degrees') });
   }
 
   scale(factor) {
-    return new Shape({ op: 'scale', shape: this.node, factor: num(factor, 'scale factor') });
+    return new CsgShape({ op: 'scale', shape: this.node, factor: num(factor, 'scale factor') });
   }
 
   mirrorX() {
-    return new Shape({ op: 'mirror_x', shape: this.node });
+    return new CsgShape({ op: 'mirror_x', shape: this.node });
   }
 
   mirrorY() {
-    return new Shape({ op: 'mirror_y', shape: this.node });
+    return new CsgShape({ op: 'mirror_y', shape: this.node });
   }
 
   mirrorZ() {
-    return new Shape({ op: 'mirror_z', shape: this.node });
+    return new CsgShape({ op: 'mirror_z', shape: this.node });
   }
 }
 
-export const sphere = (radius) => new Shape({ op: 'sphere', radius: num(radius, 'sphere radius') });
+export const sphere = (radius) => new CsgShape({ op: 'sphere', radius: num(radius, 'sphere radius') });
 
 export const box = (hx, hy, hz) =>
-  new Shape({ op: 'box', half: [num(hx, 'box hx'), num(hy, 'box hy'), num(hz, 'box hz')] });
+  new CsgShape({ op: 'box', half: [num(hx, 'box hx'), num(hy, 'box hy'), num(hz, 'box hz')] });
 
-export const roundedBox = (hx, hy, hz, radius) => new Shape({
+export const roundedBox = (hx, hy, hz, radius) => new CsgShape({
   op: 'rounded_box',
   half: [num(hx, 'rounded box hx'), num(hy, 'rounded box hy'), num(hz, 'rounded box hz')],
   radius: num(radius, 'rounded box radius'),
 });
 
 export const cylinder = (radius, halfHeight) =>
-  new Shape({ op: 'cylinder', radius: num(radius, 'cylinder radius'), half_height: num(halfHeight, 'cylinder half height') });
+  new CsgShape({ op: 'cylinder', radius: num(radius, 'cylinder radius'), half_height: num(halfHeight, 'cylinder half height') });
 
 export const cone = (radius, height) =>
-  new Shape({ op: 'cone', radius: num(radius, 'cone radius'), height: num(height, 'cone height') });
+  new CsgShape({ op: 'cone', radius: num(radius, 'cone radius'), height: num(height, 'cone height') });
 
 export const torus = (major, minor) =>
-  new Shape({ op: 'torus', major: num(major, 'torus major radius'), minor: num(minor, 'torus minor radius') });
+  new CsgShape({ op: 'torus', major: num(major, 'torus major radius'), minor: num(minor, 'torus minor radius') });
 
 export const capsule = (a, b, radius) =>
-  new Shape({ op: 'capsule', a: vec3(a, 'capsule a'), b: vec3(b, 'capsule b'), radius: num(radius, 'capsule radius') });
+  new CsgShape({ op: 'capsule', a: vec3(a, 'capsule a'), b: vec3(b, 'capsule b'), radius: num(radius, 'capsule radius') });
 
 export const plane = (normal, distance) =>
-  new Shape({ op: 'plane', normal: vec3(normal, 'plane normal'), distance: num(distance, 'plane distance') });
+  new CsgShape({ op: 'plane', normal: vec3(normal, 'plane normal'), distance: num(distance, 'plane distance') });
 
 const nary = (op) => (...shapes) => {
   if (shapes.length === 0) throw new TypeError(`${op} needs at least one shape`);
-  return new Shape({ op, args: shapes.map((s, i) => node(s, `${op} argument ${i + 1}`)) });
+  return new CsgShape({ op, args: shapes.map((s, i) => node(s, `${op} argument ${i + 1}`)) });
 };
 
 export const union = nary('union');
 export const intersect = nary('intersect');
 
 export const subtract = (a, b) =>
-  new Shape({ op: 'subtract', args: [node(a, 'subtract argument 1'), node(b, 'subtract argument 2')] });
+  new CsgShape({ op: 'subtract', args: [node(a, 'subtract argument 1'), node(b, 'subtract argument 2')] });
 
 const smooth = (op) => (a, b, k) =>
-  new Shape({ op, args: [node(a, `${op} argument 1`), node(b, `${op} argument 2`)], k: num(k, `${op} k`) });
+  new CsgShape({ op, args: [node(a, `${op} argument 1`), node(b, `${op} argument 2`)], k: num(k, `${op} k`) });
 
 export const smoothUnion = smooth('smooth_union');
 export const smoothIntersect = smooth('smooth_intersect');
 export const smoothSubtract = smooth('smooth_subtract');
 
 /** Wraps a plain CsgNode object (e.g. parsed JSON) so it can be chained. */
-export const fromJSON = (csgNode) => new Shape(node(typeof csgNode === 'string' ? JSON.parse(csgNode) : csgNode, 'fromJSON argument'));
+export const fromJSON = (csgNode) => new CsgShape(node(typeof csgNode === 'string' ? JSON.parse(csgNode) : csgNode, 'fromJSON argument'));
+
+/** The old name of CsgShape (it clashed with the compiled `Shape` of "isoforge"). */
+export { CsgShape as Shape };

@@ -13,7 +13,8 @@ let cancelFlag = null;
 let current = 0;
 let lastProgress = 0;
 
-const ready = init().then(() => {
+// `ISOFORGE_WASM` is set only by the Node wrapper (mesher-worker-node.js); browsers fetch the file.
+const ready = init(globalThis.ISOFORGE_WASM).then(() => {
   isoforge.setProgressHook((phase, fraction) => {
     const now = performance.now();
     if (now - lastProgress >= PROGRESS_EVERY) {

@@ -44,7 +44,7 @@ export interface Mesher {
     control?: CallControl,
   ): Promise<MeshResult>;
   /** The mesh as file bytes (the arrays of `result` are copied to the worker, not transferred). */
-  exportMesh(result: MeshResult, format: ExportFormat, control?: CallControl): Promise<Uint8Array>;
+  exportMesh(result: MeshResult, format: ExportFormat, control?: CallControl): Promise<Uint8Array<ArrayBuffer>>;
   /** Calls in flight: the running one and those waiting. */
   readonly busy: number;
   /** Whether cancel() stops a running call at its next checkpoint (the page is cross-origin isolated). */
@@ -61,3 +61,13 @@ export interface Mesher {
  * replaced.
  */
 export function createMesher(options?: { workerUrl?: string | URL; staleMs?: number }): Mesher;
+
+/**
+ * The mesher over workers made by `spawn()` (anything with `onmessage`, `onerror`, `postMessage`
+ * and `terminate`, as a Web Worker has); `shared` lets it cancel through a SharedArrayBuffer.
+ * The Node entry is built on it; pages use createMesher.
+ */
+export function createMesherWith(
+  spawn: () => Pick<Worker, "postMessage" | "terminate" | "onmessage" | "onerror">,
+  options?: { staleMs?: number; shared?: boolean },
+): Mesher;

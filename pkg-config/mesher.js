@@ -22,7 +22,21 @@ export class MeshingCancelled extends Error {
 
 const CANCELLED = 'meshing cancelled';
 
-export function createMesher({ workerUrl, staleMs = 250 } = {}) {
+export function createMesher({ workerUrl, staleMs } = {}) {
+  // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
+  const spawn = () => (workerUrl
+    ? new Worker(workerUrl, { type: 'module' })
+    : new Worker(new URL('./mesher-worker.js', import.meta.url), { type: 'module' }));
+  const shared = globalThis.crossOriginIsolated === true && typeof SharedArrayBuffer === 'function';
+  return createMesherWith(spawn, { staleMs, shared });
+}
+
+/**
+ * The mesher over workers made by `spawn()` (anything with `onmessage`, `onerror`, `postMessage`
+ * and `terminate`, as a Web Worker has); `shared` says whether it may share a SharedArrayBuffer
+ * with them. For the Node entry (mesher-node.js); pages use createMesher.
+ */
+export function createMesherWith(spawn, { staleMs = 250, shared = false } = {}) {
   let worker = null;
   let nextId = 1;
   /** Calls not yet sent, oldest first: { id, name, args, resolve, reject, onProgress }. */
@@ -31,15 +45,10 @@ export function createMesher({ workerUrl, staleMs = 250 } = {}) {
   let running = null;
   let staleTimer = null;
   // Job ids up to cancelFlag[0] are cancelled; the worker's progress hook reads it.
-  const cancelFlag = globalThis.crossOriginIsolated && typeof SharedArrayBuffer === 'function'
-    ? new Int32Array(new SharedArrayBuffer(4))
-    : null;
+  const cancelFlag = shared ? new Int32Array(new SharedArrayBuffer(4)) : null;
 
   const start = () => {
-    // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
-    worker = workerUrl
-      ? new Worker(workerUrl, { type: 'module' })
-      : new Worker(new URL('./mesher-worker.js', import.meta.url), { type: 'module' });
+    worker = spawn();
     if (cancelFlag) worker.postMessage({ cancelFlag: cancelFlag.buffer });
     worker.onmessage = ({ data: { id, result, error, progress } }) => {
       const job = running;

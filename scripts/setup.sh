@@ -43,7 +43,7 @@ if [ "$node_ok" != 1 ]; then
 fi
 
 if [ ! -d node_modules ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
-  log "installing npm dev tools (three.js, playwright-core)"
+  log "installing npm dev tools (three.js, playwright-core, typescript)"
   npm ci --no-audit --no-fund --loglevel=error
 else
   log "npm dev tools present"

@@ -141,7 +141,7 @@ pub fn scene_bounds(name: &str) -> Result<JsValue, JsValue> {
 #[wasm_bindgen(js_name = meshScene, unchecked_return_type = "MeshResult")]
 pub fn mesh_scene(
     name: &str,
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     to_js(&with_progress(|| pipeline::mesh_scene(name, &request)).map_err(js_error)?)
@@ -261,7 +261,7 @@ fn csg_text(json: &JsValue) -> Result<String, JsValue> {
 /// `Error` pointing into the JSON on unknown ops, misspelt or missing fields.
 #[wasm_bindgen(js_name = compileCsg)]
 pub fn compile_csg(
-    #[wasm_bindgen(unchecked_param_type = "string | CsgNode")] json: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "string | CsgNode | { toJSON(): CsgNode }")] json: JsValue,
 ) -> Result<Shape, JsValue> {
     Ok(Shape { program: Program::from_csg_json(&csg_text(&json)?).map_err(js_error)? })
 }
@@ -270,7 +270,7 @@ pub fn compile_csg(
 #[wasm_bindgen(js_name = meshShape, unchecked_return_type = "MeshResult")]
 pub fn mesh_shape(
     shape: &Shape,
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     to_js(&with_progress(|| pipeline::mesh_program(&shape.program, &request)).map_err(js_error)?)
@@ -281,7 +281,7 @@ pub fn mesh_shape(
 #[wasm_bindgen(js_name = meshExpr, unchecked_return_type = "MeshResult")]
 pub fn mesh_expr(
     text: &str,
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     to_js(&with_progress(|| pipeline::mesh_expr(text, &request)).map_err(js_error)?)
@@ -291,8 +291,8 @@ pub fn mesh_expr(
 /// [-1, 1]³.
 #[wasm_bindgen(js_name = meshCsg, unchecked_return_type = "MeshResult")]
 pub fn mesh_csg(
-    #[wasm_bindgen(unchecked_param_type = "string | CsgNode")] json: JsValue,
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "string | CsgNode | { toJSON(): CsgNode }")] json: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     let text = csg_text(&json)?;
@@ -353,7 +353,7 @@ pub fn mesh_grid(
     #[wasm_bindgen(unchecked_param_type = "[number, number, number] | Uint32Array")] dims: Vec<u32>,
     #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
     bounds: Vec<f32>,
-    #[wasm_bindgen(unchecked_param_type = "GridOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "GridOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let (request, dtype, _) = parse_grid_options(options)?;
     if dims.len() != 3 || dims.iter().any(|&d| d < 2) {
@@ -391,7 +391,7 @@ pub fn mesh_function(
     #[wasm_bindgen(unchecked_param_type = "BatchFieldFunction")] f: js_sys::Function,
     #[wasm_bindgen(unchecked_param_type = "[number, number, number, number, number, number] | Float32Array")]
     bounds: Vec<f32>,
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     let bounds = parse_bounds(&bounds)?;

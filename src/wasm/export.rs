@@ -24,7 +24,7 @@ export type MeshArrays = Pick<MeshResult, "positions" | "normals" | "indices">;
 /// `normals` may be empty) in `format`: `"obj"`, `"stl"`, `"ply"` or `"glb"`. Throws an `Error` on
 /// an unknown format or arrays that do not fit together (lengths not multiples of 3, a normal
 /// count other than zero or one per vertex, indices past the vertices).
-#[wasm_bindgen(js_name = exportMesh)]
+#[wasm_bindgen(js_name = exportMesh, unchecked_return_type = "Uint8Array<ArrayBuffer>")]
 pub fn export_mesh(
     #[wasm_bindgen(unchecked_param_type = "MeshArrays")] result: JsValue,
     #[wasm_bindgen(unchecked_param_type = "ExportFormat")] format: &str,

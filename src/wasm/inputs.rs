@@ -32,7 +32,7 @@ fn triples(values: &[f32], what: &str) -> Result<Vec<Vec3>, JsValue> {
 pub fn mesh_triangles(
     positions: &[f32],
     indices: &[u32],
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     if indices.len() % 3 != 0 {
@@ -57,7 +57,7 @@ pub fn mesh_triangles(
 pub fn mesh_points(
     positions: &[f32],
     normals: &[f32],
-    #[wasm_bindgen(unchecked_param_type = "MeshOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeshOptions")] options: Option<JsValue>,
 ) -> Result<JsValue, JsValue> {
     let request = parse_options(options)?;
     let cloud =

@@ -42,7 +42,7 @@ struct JsOptions {
 }
 
 /// Options of every function but meshGrid, which alone takes a `dtype`.
-pub(super) fn parse_options(options: JsValue) -> Result<Request, JsValue> {
+pub(super) fn parse_options(options: Option<JsValue>) -> Result<Request, JsValue> {
     let (request, dtype, gradient_given) = parse_grid_options(options)?;
     if dtype.is_some() {
         return Err(js_error(Error::InvalidOption("dtype is an option of meshGrid only".into())));
@@ -54,7 +54,10 @@ pub(super) fn parse_options(options: JsValue) -> Result<Request, JsValue> {
 }
 
 /// The request, the dtype, and whether a `gradient` was given.
-pub(super) fn parse_grid_options(options: JsValue) -> Result<(Request, Option<Dtype>, bool), JsValue> {
+pub(super) fn parse_grid_options(
+    options: Option<JsValue>,
+) -> Result<(Request, Option<Dtype>, bool), JsValue> {
+    let options = options.unwrap_or(JsValue::UNDEFINED);
     let o: JsOptions = if options.is_undefined() || options.is_null() {
         JsOptions::default()
     } else {
