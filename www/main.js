@@ -182,13 +182,19 @@ function load(name) {
   run();
 }
 
-const syncSlider = () => { $('res-slider').value = $('res').value; };
+/** Sliders follow their number fields (the fields are what the options read). */
+const syncSlider = () => {
+  $('res-slider').value = $('res').value;
+  $('depth-slider').value = $('depth').value;
+};
 
-/** The angles the cosines θ and φ stand for, beside them. */
+/** The angles the cosines θ and φ stand for, beside them and on their sliders (in degrees). */
 function showAngles() {
   for (const id of ['theta', 'phi']) {
     const c = Number($(id).value);
-    $(`${id}-deg`).textContent = Math.abs(c) <= 1 ? `= ${((Math.acos(c) * 180) / Math.PI).toFixed(1)}°` : '';
+    const degrees = (Math.acos(c) * 180) / Math.PI;
+    $(`${id}-deg`).textContent = Math.abs(c) <= 1 ? `= ${degrees.toFixed(1)}°` : '';
+    if (Math.abs(c) <= 1) $(`${id}-slider`).value = String(degrees);
   }
 }
 
@@ -232,8 +238,18 @@ $('share').addEventListener('click', async () => {
     setStatus('done', 'copy the link above');
   }
 });
-$('res-slider').addEventListener('input', () => { $('res').value = $('res-slider').value; });
-$('res-slider').addEventListener('change', optionChanged);
+for (const id of ['res', 'depth']) {
+  $(`${id}-slider`).addEventListener('input', () => { $(id).value = $(`${id}-slider`).value; });
+  $(`${id}-slider`).addEventListener('change', optionChanged);
+}
+// Angle sliders in degrees set the cosine fields.
+for (const id of ['theta', 'phi']) {
+  $(`${id}-slider`).addEventListener('input', () => {
+    $(id).value = Math.cos((Number($(`${id}-slider`).value) * Math.PI) / 180).toFixed(3);
+    showAngles();
+  });
+  $(`${id}-slider`).addEventListener('change', optionChanged);
+}
 for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds']) {
   $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }

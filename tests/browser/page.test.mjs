@@ -147,3 +147,22 @@ test('a long parse error wraps inside the editor, and the reference inserts a fu
   assert.equal(await page.inputValue('#source'), 'torus(R, r)');
   assert.ok(await page.$$eval('#reference dt', (d) => d.length) >= 40);
 });
+
+test('sliders set the options they stand beside: an angle in degrees becomes its cosine', async () => {
+  const { page } = await openDemo();
+  await page.uncheck('#live');
+  await page.$eval('#theta-slider', (s) => { s.value = '60'; s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change')); });
+  assert.equal(await page.inputValue('#theta'), '0.500');
+  assert.equal(await page.textContent('#theta-deg'), '= 60.0°');
+  await page.fill('#res', '40');
+  await page.dispatchEvent('#res', 'change');
+  assert.equal(await page.inputValue('#res-slider'), '40');
+  await page.click('#run');
+  await settled(page);
+  // A looser θ finds fewer sharp edges on the same shape (60° between normals, not 25.8°).
+  const loose = await count(page, LEFT, 'feature edges');
+  await page.$eval('#theta-slider', (s) => { s.value = '25'; s.dispatchEvent(new Event('input')); });
+  await page.click('#run');
+  await settled(page);
+  assert.ok(await count(page, LEFT, 'feature edges') >= loose);
+});
