@@ -97,4 +97,25 @@ mod tests {
             assert!(mesh_scene("rocket", &request).is_ok());
         }
     }
+
+    /// DMC's simplification, its longest stretch on deep octrees, checks in once per level, so a
+    /// stop asked for during it comes before the contouring.
+    #[test]
+    fn dmc_stops_inside_its_simplification() {
+        use crate::pipeline::{mesh_scene, Method, Request};
+        let request = Request { method: Method::Dmc, max_depth: Some(6), ..Request::default() };
+        let seen = Rc::new(RefCell::new(Vec::new()));
+        let log = seen.clone();
+        let result = with_hook(
+            move |phase, fraction| {
+                log.borrow_mut().push((phase, fraction));
+                phase == "octree" && fraction > 0.7
+            },
+            || mesh_scene("fandisk", &request),
+        );
+        assert_eq!(result.err(), Some(Error::Cancelled));
+        let seen = seen.borrow();
+        assert!(seen.iter().any(|&(p, _)| p == "feature_isolation"), "stopped after the sampling: {seen:?}");
+        assert!(!seen.iter().any(|&(p, _)| p == "contouring"), "stopped before the contouring: {seen:?}");
+    }
 }

@@ -218,7 +218,7 @@ pub fn mesh_field(
     crate::progress::checkpoint("feature_isolation", 0.0)?;
     let t = Instant::now();
     if options.simplify {
-        let s = simplify::simplify(&mut tree, field, iso, tolerance);
+        let s = simplify::simplify(&mut tree, field, iso, tolerance)?;
         stats.merges = s.merged;
         stats.unsafe_merges = s.unsafe_merges;
         stats.inaccurate_merges = s.inaccurate_merges;

@@ -58,7 +58,12 @@ fn merge(tree: &mut Octree, n: u32, qef: Option<Qef>, vertex: Vec3, value: f32) 
 /// Merges bottom-up; `tolerance` (world units) bounds both the root-mean-square 4-D distance of a
 /// leaf's sampled tangent planes from its vertex and the distance of the triangles a merge makes
 /// from the surface ([`super::fidelity`]).
-pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) -> SimplifyStats {
+pub fn simplify(
+    tree: &mut Octree,
+    field: &dyn Field,
+    iso: f32,
+    tolerance: f32,
+) -> Result<SimplifyStats, crate::Error> {
     let mut stats = SimplifyStats::default();
     let mut fidelity = Fidelity::new(field, iso, tolerance);
     let mut by_level: Vec<Vec<u32>> = vec![Vec::new(); tree.depth as usize + 1];
@@ -68,6 +73,9 @@ pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) 
         }
     }
     for level in (0..tree.depth as usize).rev() {
+        // Reported as the second half of the "octree" phase (the stats count simplification there).
+        let done = (tree.depth as usize - 1 - level) as f32 / tree.depth.max(1) as f32;
+        crate::progress::checkpoint("octree", 0.5 + 0.5 * done)?;
         // Candidates whose children are all leaves, with the vertex the merged leaf would have.
         let mut candidates: Vec<(u32, Option<Qef>, Vec3, bool)> = Vec::new();
         for &n in &by_level[level] {
@@ -151,5 +159,5 @@ pub fn simplify(tree: &mut Octree, field: &dyn Field, iso: f32, tolerance: f32) 
             }
         }
     }
-    stats
+    Ok(stats)
 }
