@@ -8,7 +8,7 @@
 //! sign change on either grid. Cells that may hold the surface are evaluated exactly.
 
 use crate::error::Error;
-use crate::field::{for_each_tile, Field, TILE};
+use crate::field::Field;
 use crate::grid::Grid;
 
 /// Boxes at most this many cells on a side are sampled without further bounding.
@@ -104,34 +104,8 @@ impl Traversal<'_> {
     /// Evaluates the marked points tile by tile (see [`crate::field::sample_grid`]; they
     /// overwrite stand-ins) and checks them.
     fn finish(mut self) -> Result<CrustSamples, Error> {
-        let mut points = Vec::with_capacity(TILE * TILE * TILE);
-        let mut indices = Vec::with_capacity(TILE * TILE * TILE);
-        let mut out = vec![0.0f32; TILE * TILE * TILE];
-        let mut evaluated = 0;
-        let grid = self.grid;
-        for_each_tile(grid.points(), "sample", |lo, hi| {
-            points.clear();
-            indices.clear();
-            for k in lo[2]..hi[2] {
-                for j in lo[1]..hi[1] {
-                    for i in lo[0]..hi[0] {
-                        let n = grid.index(i, j, k);
-                        if self.marked[n] {
-                            points.push(grid.position(i, j, k));
-                            indices.push(n);
-                        }
-                    }
-                }
-            }
-            if points.is_empty() {
-                return;
-            }
-            self.field.values(&points, &mut out[..points.len()]);
-            for (&n, &v) in indices.iter().zip(&out) {
-                self.values[n] = v;
-            }
-            evaluated += points.len();
-        })?;
+        let marked = &self.marked;
+        let evaluated = crate::field::sample_tiles(self.field, self.grid, |n| marked[n], &mut self.values)?;
         crate::field::check_finite(&self.values, self.grid)?;
         Ok(CrustSamples { values: self.values, evaluated, interval_queries: self.interval_queries })
     }

@@ -193,27 +193,49 @@ pub fn finite_difference_gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
 /// Fails on the first non-finite value, naming it, because meshing it would be silently wrong.
 pub fn sample_grid(field: &dyn Field, grid: &Grid) -> Result<Vec<f32>, Error> {
     let mut values = vec![0.0f32; grid.point_count()];
+    sample_tiles(field, grid, |_| true, &mut values)?;
+    check_finite(&values, grid)?;
+    Ok(values)
+}
+
+/// Evaluates `field` at the points of `grid` whose index `keep` accepts, tile by tile (one
+/// [`Field::values`] call per tile), writing each value to `values` at the point's index; the
+/// others are left as they are. Returns how many points were evaluated. Shared by whole grids
+/// and by the crust ([`crate::crust`]).
+pub fn sample_tiles(
+    field: &dyn Field,
+    grid: &Grid,
+    keep: impl Fn(usize) -> bool,
+    values: &mut [f32],
+) -> Result<usize, Error> {
     let mut points = Vec::with_capacity(TILE * TILE * TILE);
     let mut indices = Vec::with_capacity(TILE * TILE * TILE);
     let mut out = vec![0.0f32; TILE * TILE * TILE];
+    let mut evaluated = 0;
     for_each_tile(grid.points(), "sample", |lo, hi| {
         points.clear();
         indices.clear();
         for k in lo[2]..hi[2] {
             for j in lo[1]..hi[1] {
                 for i in lo[0]..hi[0] {
-                    points.push(grid.position(i, j, k));
-                    indices.push(grid.index(i, j, k));
+                    let n = grid.index(i, j, k);
+                    if keep(n) {
+                        points.push(grid.position(i, j, k));
+                        indices.push(n);
+                    }
                 }
             }
+        }
+        if points.is_empty() {
+            return;
         }
         field.values(&points, &mut out[..points.len()]);
         for (&n, &v) in indices.iter().zip(&out) {
             values[n] = v;
         }
+        evaluated += points.len();
     })?;
-    check_finite(&values, grid)?;
-    Ok(values)
+    Ok(evaluated)
 }
 
 /// Points per side of the tiles that grids are sampled in.
