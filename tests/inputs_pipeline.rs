@@ -244,13 +244,13 @@ mod wasm_api {
     fn mesh_triangles_remeshes_typed_arrays() {
         let m = octahedron(0.8);
         let indices: Vec<u32> = m.triangles.iter().flatten().copied().collect();
-        let r = mesh_triangles(&flat(&m.positions), &indices, options("emc")).unwrap();
+        let r = mesh_triangles(&flat(&m.positions), &indices, Some(options("emc"))).unwrap();
         let stats = get(&r, "stats");
         assert_eq!(get(&stats, "closed_manifold"), JsValue::TRUE);
         assert_eq!(get(&stats, "euler").as_f64(), Some(2.0));
         assert_eq!(get(&stats, "corner_features").as_f64(), Some(6.0));
         assert!(get(&r, "featureEdges").unchecked_into::<js_sys::Uint32Array>().length() > 0);
-        let err = mesh_triangles(&[0.0; 7], &indices, JsValue::UNDEFINED).unwrap_err();
+        let err = mesh_triangles(&[0.0; 7], &indices, None).unwrap_err();
         let message = err.unchecked_into::<js_sys::Error>().message();
         assert!(String::from(message).contains("xyz triples"));
     }
@@ -258,11 +258,11 @@ mod wasm_api {
     #[test]
     fn mesh_points_reconstructs_typed_arrays() {
         let cloud = sphere_cloud(5000, 0.7, Vec3::ZERO);
-        let r = mesh_points(&flat(&cloud.positions), &flat(&cloud.normals), options("emc")).unwrap();
+        let r = mesh_points(&flat(&cloud.positions), &flat(&cloud.normals), Some(options("emc"))).unwrap();
         let stats = get(&r, "stats");
         assert_eq!(get(&stats, "closed_manifold"), JsValue::TRUE);
         assert_eq!(get(&stats, "euler").as_f64(), Some(2.0));
-        let err = mesh_points(&flat(&cloud.positions), &[0.0, 0.0, 1.0], JsValue::UNDEFINED).unwrap_err();
+        let err = mesh_points(&flat(&cloud.positions), &[0.0, 0.0, 1.0], None).unwrap_err();
         let message = String::from(err.unchecked_into::<js_sys::Error>().message());
         assert!(message.contains("every point needs a normal"), "{message}");
     }
