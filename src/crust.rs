@@ -101,8 +101,8 @@ impl Traversal<'_> {
         }
     }
 
-    /// Evaluates the marked points tile by tile (see [`crate::field::sample_grid`]; they
-    /// overwrite stand-ins) and checks them.
+    /// Evaluates the marked points tile by tile ([`crate::field::sample_tiles`]; they overwrite
+    /// stand-ins) and checks them.
     fn finish(mut self) -> Result<CrustSamples, Error> {
         let marked = &self.marked;
         let evaluated = crate::field::sample_tiles(self.field, self.grid, |n| marked[n], &mut self.values)?;

@@ -229,7 +229,7 @@ $('fit-bounds').addEventListener('click', () => {
 });
 $('share').addEventListener('click', async () => {
   remember();
-  const url = session.shareUrl(collect());
+  const url = location.href;
   Object.assign($('share-url'), { value: url, hidden: false }).select();
   try {
     await navigator.clipboard.writeText(url);

@@ -4,11 +4,12 @@
 //! For each of the six directions a best-first branch-and-bound search looks for the farthest
 //! point that interval arithmetic cannot prove to be outside: cells are kept in a heap by how far
 //! they reach in that direction, a cell whose bound on the value is above zero is dropped (no
-//! inside point there), and the first cell popped at the finest size gives the answer. Every
-//! dropped cell holds no inside point and every cell still queued reaches less far, so the
-//! answer is never short of the true extent: the box is conservative by construction, and tight
-//! up to the finest size plus interval arithmetic's over-estimate. When the search runs out of
-//! budget, the best queued cell's reach is still a valid (looser) answer.
+//! inside point there), and the search stops once the farthest queued cell reaches no more than a
+//! tolerance past an inside point already found; that cell's reach is the answer. Every dropped
+//! cell holds no inside point and every cell still queued reaches less far, so the answer is
+//! never short of the true extent: the box is conservative by construction, and tight up to the
+//! tolerance plus interval arithmetic's over-estimate. When the search runs out of budget, the
+//! best queued cell's reach is still a valid (looser) answer.
 
 use super::Program;
 use crate::Vec3;
@@ -201,7 +202,7 @@ mod tests {
 
     /// Random unions of moved balls and rotated boxes: the found box holds the analytic extent
     /// (a ball's centre ± r; a box turned by R reaches Σ_j |R_ij| h_j from its centre) and is
-    /// loose by no more than a few finest cells.
+    /// loose by no more than 1 % of its size.
     #[test]
     fn random_shapes_fit_their_extent_conservatively_and_tightly() {
         let mut rng = crate::expr::testutil::Rng::new(0xe47e);

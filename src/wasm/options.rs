@@ -57,12 +57,13 @@ pub(super) fn parse_options(options: Option<JsValue>) -> Result<Request, JsValue
 pub(super) fn parse_grid_options(
     options: Option<JsValue>,
 ) -> Result<(Request, Option<Dtype>, bool), JsValue> {
-    let options = options.unwrap_or(JsValue::UNDEFINED);
-    let o: JsOptions = if options.is_undefined() || options.is_null() {
-        JsOptions::default()
-    } else {
-        check_keys(&options)?;
-        serde_wasm_bindgen::from_value(options).map_err(|e| js_error(format!("invalid options: {e}")))?
+    // wasm-bindgen passes `undefined` and `null` as None.
+    let o: JsOptions = match options {
+        None => JsOptions::default(),
+        Some(options) => {
+            check_keys(&options)?;
+            serde_wasm_bindgen::from_value(options).map_err(|e| js_error(format!("invalid options: {e}")))?
+        }
     };
     let mut r = Request::default();
     if let Some(m) = &o.method {
