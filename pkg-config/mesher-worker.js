@@ -3,8 +3,8 @@
 // not copied. It stays alive between calls, keeping its compiled module.
 import init, * as isoforge from './isoforge.js';
 
-// What a page may ask for: the meshing and export functions, nothing else of the module.
-const CALLS = new Set(['meshScene', 'meshExpr', 'meshCsg', 'meshGrid', 'exportMesh']);
+// What a page may ask for: the meshing, analysis and export functions, nothing else of the module.
+const CALLS = new Set(['meshScene', 'meshExpr', 'meshCsg', 'meshGrid', 'analyzeMesh', 'exportMesh']);
 // Progress events at most this often (ms).
 const PROGRESS_EVERY = 100;
 

@@ -11,7 +11,7 @@
 // stops at its next checkpoint where the page is cross-origin isolated (SharedArrayBuffer), and is
 // otherwise left to finish unseen, its worker replaced if it runs `staleMs` longer.
 
-import type { CsgNode, GridOptions, MeshOptions, MeshResult } from "./isoforge.js";
+import type { AnalyzeOptions, CsgNode, GridOptions, MeshAnalysis, MeshOptions, MeshResult } from "./isoforge.js";
 
 /** Optional control of one call. */
 export interface CallControl {
@@ -43,6 +43,11 @@ export interface Mesher {
     options?: GridOptions,
     control?: CallControl,
   ): Promise<MeshResult>;
+  /**
+   * analyzeMesh in the worker: the mesh's error against `options.expr` / `options.csg` and its
+   * crossing triangles, for a result already shown (its arrays are copied, not transferred).
+   */
+  analyzeMesh(result: MeshResult, options?: AnalyzeOptions, control?: CallControl): Promise<MeshAnalysis>;
   /** The mesh as file bytes (the arrays of `result` are copied to the worker, not transferred). */
   exportMesh(result: MeshResult, format: ExportFormat, control?: CallControl): Promise<Uint8Array<ArrayBuffer>>;
   /** Calls in flight: the running one and those waiting. */

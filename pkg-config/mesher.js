@@ -22,6 +22,9 @@ export class MeshingCancelled extends Error {
 
 const CANCELLED = 'meshing cancelled';
 
+/** The arrays of a result the worker reads: the rest (stats, feature lines) is not copied there. */
+const meshArrays = ({ positions, normals, indices }) => ({ positions, normals, indices });
+
 export function createMesher({ workerUrl, staleMs } = {}) {
   // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
   const spawn = () => (workerUrl
@@ -134,7 +137,8 @@ export function createMesherWith(spawn, { staleMs = 250, shared = false } = {}) 
     meshExpr: (text, options, control) => call('meshExpr', [text, options], control),
     meshCsg: (tree, options, control) => call('meshCsg', [typeof tree === 'string' ? tree : JSON.stringify(tree), options], control),
     meshGrid: (values, dims, bounds, options, control) => call('meshGrid', [values, dims, bounds, options], control),
-    exportMesh: (result, format, control) => call('exportMesh', [result, format], control),
+    analyzeMesh: (result, options, control) => call('analyzeMesh', [meshArrays(result), options], control),
+    exportMesh: (result, format, control) => call('exportMesh', [meshArrays(result), format], control),
     /** Calls in flight: the running one and those waiting. */
     get busy() { return queue.length + (running && !running.abandoned ? 1 : 0); },
     /** Whether a running call can be stopped at once (shared memory), rather than left to finish. */

@@ -287,7 +287,7 @@ impl Meshed {
             return Err(Error::NonFiniteOutput { method: method.name(), index, position });
         }
         crate::progress::checkpoint("analysis", 0.0)?;
-        let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options);
+        let mut stats = stats::compute(method.name(), res, &self.mesh, truth, self.phases, options)?;
         stats.set_feature_counts(self.feature_edges.len(), self.feature_counts);
         stats.points_evaluated = self.evaluations.map(|e| e.0);
         stats.grid_points = self.evaluations.map(|e| e.1);

@@ -118,4 +118,31 @@ mod tests {
         assert!(seen.iter().any(|&(p, _)| p == "feature_isolation"), "stopped after the sampling: {seen:?}");
         assert!(!seen.iter().any(|&(p, _)| p == "contouring"), "stopped before the contouring: {seen:?}");
     }
+
+    /// The surface measurement of a large mesh checks in every few thousand faces: a stop asked
+    /// for half way ends it there, and without a hook it measures what `surface_error` does.
+    #[test]
+    fn the_surface_measurement_stops_part_way() {
+        use crate::mesh::analysis::{surface_error, surface_error_cancellable};
+        use crate::pipeline::{mesh_scene, Request};
+        let out = mesh_scene("torus", &Request { res: 64, ..Request::default() }).unwrap();
+        let field = crate::scenes::scene("torus").unwrap().field;
+        assert!(out.mesh.triangle_count() > 4 * 4096, "{} triangles", out.mesh.triangle_count());
+        let fractions = Rc::new(RefCell::new(Vec::new()));
+        let log = fractions.clone();
+        let stopped = with_hook(
+            move |_, fraction| {
+                log.borrow_mut().push(fraction);
+                fraction >= 0.5
+            },
+            || surface_error_cancellable(&out.mesh, field.as_ref()),
+        );
+        assert_eq!(stopped, Err(Error::Cancelled));
+        let fractions = fractions.borrow();
+        assert!(fractions.len() >= 3 && fractions.windows(2).all(|w| w[0] < w[1]), "{fractions:?}");
+        assert_eq!(
+            surface_error_cancellable(&out.mesh, field.as_ref()),
+            Ok(surface_error(&out.mesh, field.as_ref()))
+        );
+    }
 }

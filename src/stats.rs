@@ -1,6 +1,7 @@
 //! The one summary of a meshing run, shared by the CLI's `--stats`, the wasm API and the benches.
 //! Field names are a contract (scripts parse them): add freely, never rename.
 
+use crate::error::Error;
 use crate::field::Field;
 use crate::mesh::analysis;
 use crate::mesh::Mesh;
@@ -135,7 +136,8 @@ impl Stats {
     }
 }
 
-/// Analyses `mesh` against `field` (its true surface) and bundles the numbers with the timings.
+/// Analyses `mesh` against `field` (its true surface) and bundles the numbers with the timings;
+/// fails only with [`Error::Cancelled`], where a progress hook stops the surface measurement.
 pub fn compute(
     method: &str,
     res: usize,
@@ -143,16 +145,17 @@ pub fn compute(
     field: &dyn Field,
     phases_ms: Vec<(String, f64)>,
     options: AnalysisOptions,
-) -> Stats {
+) -> Result<Stats, Error> {
     let t0 = Instant::now();
     let topo = analysis::topology(mesh);
     let angles = analysis::angle_stats(mesh);
     let (aspect_mean, aspect_max) = analysis::aspect_ratios(mesh);
     let intersections = options.self_intersections.then(|| analysis::self_intersections(mesh));
-    let error =
-        (options.surface_error && mesh.triangle_count() > 0).then(|| analysis::surface_error(mesh, field));
+    let error = (options.surface_error && mesh.triangle_count() > 0)
+        .then(|| analysis::surface_error_cancellable(mesh, field))
+        .transpose()?;
     let ms_total = phases_ms.iter().map(|(_, ms)| ms).sum();
-    Stats {
+    Ok(Stats {
         method: method.to_string(),
         res,
         vertices: mesh.vertex_count(),
@@ -186,7 +189,7 @@ pub fn compute(
         phases_ms,
         ms_analysis: crate::mc::ms_since(t0),
         ..Stats::default()
-    }
+    })
 }
 
 fn phases_as_object<S: serde::Serializer>(phases: &[(String, f64)], s: S) -> Result<S::Ok, S::Error> {

@@ -1,6 +1,7 @@
-// "Show bad triangles": the faces a modeller should look at, found from the mesh alone. Slivers
-// (a corner under `minAngleDeg`) and edges that break the manifold (used by one face: a hole;
-// by three or more: a fin or a pinch).
+// "Show bad triangles": the faces a modeller should look at. Slivers (a corner under
+// `minAngleDeg`) and edges that break the manifold (used by one face: a hole; by three or more: a
+// fin or a pinch) are found here from the mesh alone; triangles that cross another come from the
+// library's analysis (analyzeMesh), which the pane asks for after showing the mesh.
 
 /** The smallest corner angle of the triangle (a, b, c) of `p` (xyz triples), in degrees. */
 function smallestAngle(p, a, b, c) {
@@ -14,10 +15,11 @@ function smallestAngle(p, a, b, c) {
 }
 
 /**
- * `{ slivers, openEdges, nonManifoldEdges }` of a MeshResult: slivers as a Uint32Array of
- * triangle corners (three per triangle, like `indices`), the edges as vertex pairs.
+ * `{ slivers, crossing, openEdges, nonManifoldEdges }` of a MeshResult: slivers and the triangles
+ * of `crossingPairs` (triangle index pairs from analyzeMesh, or null) as Uint32Arrays of triangle
+ * corners (three per triangle, like `indices`), the edges as vertex pairs.
  */
-export function badTriangles({ positions, indices }, minAngleDeg = 10) {
+export function badTriangles({ positions, indices }, crossingPairs = null, minAngleDeg = 10) {
   const slivers = [];
   const uses = new Map();
   const n = positions.length / 3;
@@ -36,5 +38,6 @@ export function badTriangles({ positions, indices }, minAngleDeg = 10) {
     const pair = [Math.floor(key / n), key % n];
     (count === 1 ? openEdges : nonManifoldEdges).push(...pair);
   }
-  return { slivers: Uint32Array.from(slivers), openEdges: Uint32Array.from(openEdges), nonManifoldEdges: Uint32Array.from(nonManifoldEdges) };
+  const crossing = [...new Set(crossingPairs ?? [])].flatMap((t) => [indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]]);
+  return { slivers: Uint32Array.from(slivers), crossing: Uint32Array.from(crossing), openEdges: Uint32Array.from(openEdges), nonManifoldEdges: Uint32Array.from(nonManifoldEdges) };
 }

@@ -95,7 +95,8 @@ function fitBounds() {
 
 /** Options for one pane's method: grid methods take a resolution, DMC a tolerance and depth. */
 function options(method, bounds) {
-  const common = { bounds, surfaceError: true };
+  // The error numbers come after the mesh is shown (Pane.measure), not with it.
+  const common = { bounds };
   if (method === 'dmc') {
     return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
   }

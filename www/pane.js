@@ -11,7 +11,7 @@ import { drawHistogram, statsRows } from './numbers.js';
 import { badTriangles } from './bad.js';
 
 const MATERIAL = { flatShading: true, roughness: 0.55, metalness: 0.05, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 };
-const BAD = { sliver: 0xe03131, edge: 0xf08c00 };
+const BAD = { sliver: 0xe03131, edge: 0xf08c00, crossing: 0x9c36b5 };
 
 /** `{ cells, maxCells }` from a too-large error's message, or null. */
 export function tooLarge(message) {
@@ -105,8 +105,9 @@ export class Pane {
       bar.value = fraction;
       busy.querySelector('.phase').textContent = phase;
     };
+    let result;
     try {
-      const result = await this.mesher.meshExpr(text, { ...options, method: this.method }, { onProgress });
+      result = await this.mesher.meshExpr(text, { ...options, method: this.method }, { onProgress });
       this.display(result);
       this.setState('done', `${result.stats.triangles.toLocaleString('en')} triangles, ${result.stats.ms_total.toFixed(0)} ms`);
     } catch (e) {
@@ -118,6 +119,29 @@ export class Pane {
     } finally {
       clearInterval(tick);
       if (this.call === call) busy.hidden = true;
+    }
+    if (result && this.call === call) await this.measure(text, result, call);
+  }
+
+  /**
+   * Measures the mesh shown (its distance and normal error against the program, and the
+   * triangles that cross) after it is on screen: the numbers cost as much as meshing, the picture
+   * should not wait for them. `data-measured` is "pending" until they are in, then "yes".
+   */
+  async measure(text, result, call) {
+    this.root.dataset.measured = 'pending';
+    try {
+      const measured = await this.mesher.analyzeMesh(result, { expr: text, checkIntersections: true });
+      if (this.call !== call) return;
+      const { self_intersecting_pairs: pairs, ...numbers } = measured;
+      Object.assign(result.stats, numbers, { ms_analysis: result.stats.ms_analysis + numbers.ms_analysis });
+      this.crossing = pairs;
+      this.root.querySelector('.stats').replaceChildren(...statsRows(result.stats));
+      if (this.bad) this.refreshBad();
+      this.root.dataset.measured = 'yes';
+    } catch (e) {
+      // A newer request cancelled it: that one measures its own mesh.
+      if (e.name !== 'AbortError' && this.call === call) this.root.dataset.measured = `failed: ${e.message}`;
     }
   }
 
@@ -140,7 +164,7 @@ export class Pane {
     for (const o of this.objects) { o.geometry.dispose(); this.scene.remove(o); }
     this.objects = [];
     this.result = null;
-    this.features = this.normals = this.bad = null;
+    this.features = this.normals = this.bad = this.crossing = null;
     this.root.querySelector('.stats').replaceChildren();
     drawHistogram(this.root.querySelector('.histogram'), null);
     this.root.querySelector('.download').disabled = true;
@@ -187,25 +211,43 @@ export class Pane {
     if (this.bad) for (const o of this.bad) o.visible = this.show.bad;
   }
 
-  /** Overlays slivers (red) and open or non-manifold edges (orange), counted in `data-bad`. */
+  /**
+   * Overlays slivers (red), open or non-manifold edges (orange) and, once the mesh is measured,
+   * triangles that cross another (purple), counted in `data-bad` (`crossing` is null until then).
+   */
   addBad() {
-    const found = badTriangles(this.result);
+    const found = badTriangles(this.result, this.crossing);
     const position = this.objects[0].geometry.getAttribute('position');
-    const slivers = new THREE.BufferGeometry();
-    slivers.setAttribute('position', position);
-    slivers.setIndex(new THREE.BufferAttribute(found.slivers, 1));
-    const edges = new THREE.BufferGeometry();
-    edges.setAttribute('position', position);
-    edges.setIndex(new THREE.BufferAttribute(Uint32Array.from([...found.openEdges, ...found.nonManifoldEdges]), 1));
+    const faces = (indices) => {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', position);
+      geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+      return geometry;
+    };
+    const edges = faces(Uint32Array.from([...found.openEdges, ...found.nonManifoldEdges]));
     this.bad = [
-      new THREE.Mesh(slivers, new THREE.MeshBasicMaterial({ color: BAD.sliver, side: THREE.DoubleSide })),
+      new THREE.Mesh(faces(found.slivers), new THREE.MeshBasicMaterial({ color: BAD.sliver, side: THREE.DoubleSide })),
+      new THREE.Mesh(faces(found.crossing), new THREE.MeshBasicMaterial({ color: BAD.crossing, side: THREE.DoubleSide })),
       new THREE.LineSegments(edges, new THREE.LineBasicMaterial({ color: BAD.edge })),
     ];
     this.objects.push(...this.bad);
     this.scene.add(...this.bad);
     this.root.dataset.bad = JSON.stringify({
       slivers: found.slivers.length / 3, openEdges: found.openEdges.length / 2, nonManifoldEdges: found.nonManifoldEdges.length / 2,
+      crossing: this.crossing ? found.crossing.length / 3 : null,
     });
+  }
+
+  /** Rebuilds the overlay (the crossing triangles came in after it was drawn). */
+  refreshBad() {
+    for (const o of this.bad) {
+      o.geometry.dispose();
+      this.scene.remove(o);
+      this.objects.splice(this.objects.indexOf(o), 1);
+    }
+    this.bad = null;
+    this.applyToggles();
+    this.onChange();
   }
 
   /** Saves the mesh shown; the bytes are made here, on the main thread, in milliseconds. */

@@ -34,7 +34,8 @@ pub fn export_mesh(
     export::to_bytes(&mesh, format).map_err(js_error)
 }
 
-fn mesh_from_arrays(result: &JsValue) -> Result<Mesh, JsValue> {
+/// The mesh of a result's arrays, checked as far as `exportMesh` needs (see [`export_mesh`]).
+pub(super) fn mesh_from_arrays(result: &JsValue) -> Result<Mesh, JsValue> {
     if !result.is_object() {
         return Err(invalid("exportMesh needs a mesh result: { positions, normals, indices }".into()));
     }

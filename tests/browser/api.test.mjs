@@ -206,3 +206,49 @@ test('mcq meshes through the same options and snapping can be turned off', async
   assert.notEqual(r.perCell, r.mcq.triangles);
   assert.match(r.bad, /snap must be in/);
 });
+
+test('analyzeMesh measures a result after the fact: the same error as surfaceError, and the crossing pairs', async () => {
+  const r = await inPage((m) => {
+    const text = 'subtract(box(0.6, 0.6, 0.6), sphere(0.75))';
+    const withStats = m.meshExpr(text, { method: 'emc', res: 24, surfaceError: true, checkIntersections: true });
+    const plain = m.meshExpr(text, { method: 'emc', res: 24 });
+    const after = m.analyzeMesh(plain, { expr: text, checkIntersections: true });
+    const fromCsg = m.analyzeMesh(plain, { csg: { op: 'subtract', args: [{ op: 'box', half: [0.6, 0.6, 0.6] }, { op: 'sphere', radius: 0.75 }] } });
+    // Two triangles that cross through each other's middles, and a third far away.
+    const positions = new Float32Array([-1, -1, 0, 1, -1, 0, 0, 1, 0, 0, 0, -1, 0, 0.2, 1, 0, -0.8, 1, 5, 5, 5, 6, 5, 5, 5, 6, 5]);
+    const crossing = m.analyzeMesh({ positions, indices: new Uint32Array([0, 1, 2, 3, 4, 5, 6, 7, 8]) }, { checkIntersections: true });
+    const errors = [];
+    for (const [arrays, options] of [
+      [plain, { exp: text }],
+      [plain, { expr: text, csg: '{}' }],
+      [plain, { expr: 'sphere(' }],
+      [{ positions, indices: new Uint32Array([0, 1, 9]) }, {}],
+      [{ positions: new Float32Array([0, 0, NaN, 1, 0, 0, 0, 1, 0]), indices: new Uint32Array([0, 1, 2]) }, {}],
+      [plain, { checkIntersections: 'yes' }],
+    ]) {
+      try { m.analyzeMesh(arrays, options); errors.push(null); } catch (e) { errors.push(e.message); }
+    }
+    const pick = (o) => [o.dist_max, o.dist_rms, o.normal_dev_deg_p95, o.crease_faces, o.self_intersections];
+    return {
+      withStats: pick(withStats.stats), after: pick(after), csg: pick(fromCsg), plain: pick(plain.stats),
+      afterPairs: after.self_intersecting_pairs.length, csgPairs: fromCsg.self_intersecting_pairs.constructor.name,
+      crossing: [crossing.self_intersections, Array.from(crossing.self_intersecting_pairs), crossing.dist_max],
+      errors,
+    };
+  });
+  // Measured after the fact, on the same mesh, against the same program: the same numbers.
+  assert.deepEqual(r.after, r.withStats);
+  assert.deepEqual(r.csg.slice(0, 4), r.withStats.slice(0, 4));
+  assert.equal(r.csg[4], null, 'crossings only when asked');
+  assert.deepEqual(r.plain, [null, null, null, null, null], 'a plain mesh call measures nothing');
+  assert.ok(r.after[0] > 0 && r.after[0] < 2 / 24, `dist_max ${r.after[0]} within a cell`);
+  assert.equal(r.afterPairs, 2 * r.after[4]);
+  assert.equal(r.csgPairs, 'Uint32Array');
+  assert.deepEqual(r.crossing, [1, [0, 1], null]);
+  assert.match(r.errors[0], /unknown analyzeMesh option `exp`/);
+  assert.match(r.errors[1], /expr or csg, not both/);
+  assert.match(r.errors[2], /^1:\d+: /);
+  assert.match(r.errors[3], /refers past the 9 vertices/);
+  assert.match(r.errors[4], /vertex 0 is not finite/);
+  assert.match(r.errors[5], /checkIntersections must be a boolean/);
+});

@@ -6,16 +6,21 @@ import { serve, launch } from '../../scripts/browser.mjs';
 export const LEFT = '.pane[data-side="left"]';
 export const RIGHT = '.pane[data-side="right"]';
 
-/** Waits until neither pane is meshing; fails on a pane error unless `allowErrors`. */
+/**
+ * Waits until neither pane is meshing, nor measuring a mesh it shows; fails on a pane error
+ * unless `allowErrors`.
+ */
 export async function settled(page, { allowErrors = false } = {}) {
   await page.waitForFunction(() => {
     const panes = [...document.querySelectorAll('.pane')];
-    return panes.length === 2 && panes.every((p) => ['done', 'error', 'stopped'].includes(p.dataset.state));
+    const idle = (p) => ['error', 'stopped'].includes(p.dataset.state) || (p.dataset.state === 'done' && p.dataset.measured !== 'pending');
+    return panes.length === 2 && panes.every(idle);
   }, null, { timeout: 120_000 });
   if (!allowErrors) {
     for (const side of [LEFT, RIGHT]) {
       const state = await page.$eval(side, (p) => [p.dataset.state, p.querySelector('.state').textContent]);
       assert.equal(state[0], 'done', `${side}: ${state[1]}`);
+      assert.equal(await page.$eval(side, (p) => p.dataset.measured), 'yes', `${side}: measured`);
     }
   }
 }

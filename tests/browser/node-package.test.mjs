@@ -8,14 +8,17 @@ import { existsSync, mkdtempSync, mkdirSync, readFileSync, symlinkSync, writeFil
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 
-/** Runs `script` with Node in a scratch project that has the built package installed; its stdout. */
-function runInProject(script) {
+/**
+ * Runs `script` with Node in a scratch project that has the built package installed, as `file`
+ * (its extension picks ES module or CommonJS); its stdout.
+ */
+function runInProject(script, file = 'script.mjs') {
   assert.ok(existsSync('pkg/node.js'), 'pkg/ is not built: run scripts/build-wasm.sh first');
   const dir = mkdtempSync(join(tmpdir(), 'isoforge-node-'));
   mkdirSync(join(dir, 'node_modules'));
   symlinkSync(resolve('pkg'), join(dir, 'node_modules', 'isoforge'), 'dir');
-  writeFileSync(join(dir, 'script.mjs'), script);
-  return { dir, out: execFileSync(process.execPath, ['script.mjs'], { cwd: dir, encoding: 'utf8', timeout: 120_000 }) };
+  writeFileSync(join(dir, file), script);
+  return { dir, out: execFileSync(process.execPath, [file], { cwd: dir, encoding: 'utf8', timeout: 120_000 }) };
 }
 
 test("the npm README's Node example writes STL files and exits", () => {
@@ -47,4 +50,24 @@ test('under Node, cancel() stops a running call at its next checkpoint and the w
   assert.equal(r.stopped, 'AbortError');
   assert.equal(r.stopsAtOnce, true);
   assert.equal(r.euler, 2);
+});
+
+test('CommonJS: require() loads the package and its mesher (Node ≥ 20.19)', () => {
+  const { out } = runInProject(`
+    const { default: init, meshExpr, analyzeMesh } = require('isoforge');
+    const { createMesher } = require('isoforge/mesher');
+    (async () => {
+      await init();
+      const part = meshExpr('sphere(0.5)', { res: 24 });
+      const measured = analyzeMesh(part, { expr: 'sphere(0.5)', checkIntersections: true });
+      const ring = await createMesher().meshExpr('torus(0.6, 0.2)', { res: 32 });
+      console.log(JSON.stringify({ euler: part.stats.euler, ring: ring.stats.euler, dist: measured.dist_max, crossing: measured.self_intersections }));
+    })();
+  `, 'script.cjs');
+  const r = JSON.parse(out);
+  assert.equal(r.euler, 2);
+  assert.equal(r.ring, 0);
+  // 24 cells over [-1, 1]: MC's vertices lie within a small fraction of a cell (1/12) of the sphere.
+  assert.ok(r.dist > 0 && r.dist < 0.01, `dist_max ${r.dist}`);
+  assert.equal(r.crossing, 0);
 });

@@ -129,6 +129,11 @@ test('bad triangles are counted and shown where the numbers say they are', async
     // angle reported is under 10°. A closed manifold has no open or non-manifold edge.
     assert.equal(bad.slivers > 0, smallest < 10, `${side}: ${JSON.stringify(bad)} vs ${smallest}`);
     assert.equal(bad.openEdges + bad.nonManifoldEdges, 0, side);
+    // Crossing triangles are those of the pairs the analysis counted (settled() waited for it).
+    const pairs = await count(page, side, 'crossing pairs');
+    assert.ok(Number.isInteger(bad.crossing), `${side}: crossing not measured: ${JSON.stringify(bad)}`);
+    assert.equal(bad.crossing > 0, pairs > 0, side);
+    assert.ok(bad.crossing <= 2 * pairs, side);
   }
 });
 

@@ -5,6 +5,7 @@
 //! of trusting `|value|`: only signed distance fields have `|value| = distance`, and the library
 //! meshes many fields that are not (gyroids, sampled volumes, CSG blends).
 
+use crate::error::Error;
 use crate::field::{finite_difference_gradient, Field};
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
@@ -60,6 +61,27 @@ pub const CREASE_DEG: f64 = 30.0;
 /// of the normal statistics, as are faces where the gradient vanishes. An outward-facing mesh of a
 /// field that grows outward has deviations near 0; a flipped face shows up near 180 degrees.
 pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
+    match measure(mesh, field, |_| Ok::<(), std::convert::Infallible>(())) {
+        Ok(error) => error,
+        Err(never) => match never {},
+    }
+}
+
+/// [`surface_error`] with a [`checkpoint`](crate::progress::checkpoint) every few thousand faces:
+/// on a large mesh the measurement costs as much as meshing, and a page that abandons a request
+/// must be able to stop it there too.
+pub fn surface_error_cancellable(mesh: &Mesh, field: &dyn Field) -> Result<SurfaceError, Error> {
+    measure(mesh, field, |fraction| crate::progress::checkpoint("analysis", fraction))
+}
+
+/// Faces measured between two calls of the `tick` of [`measure`].
+const FACES_PER_TICK: usize = 4096;
+
+fn measure<E>(
+    mesh: &Mesh,
+    field: &dyn Field,
+    mut tick: impl FnMut(f32) -> Result<(), E>,
+) -> Result<SurfaceError, E> {
     let faces: Vec<[u32; 3]> =
         mesh.triangles.iter().copied().filter(|&[a, b, c]| a != b && b != c && a != c).collect();
     let mut referenced = vec![false; mesh.positions.len()];
@@ -73,7 +95,7 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
         .filter(|(_, &r)| r)
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (&p, _)| (lo.min(p), hi.max(p)));
     if faces.is_empty() {
-        return SurfaceError::default();
+        return Ok(SurfaceError::default());
     }
     let diagonal = (hi - lo).length() as f64;
     let largest_coordinate = lo.abs().max(hi.abs()).max_element() as f64;
@@ -104,7 +126,10 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
     let crease_cos = CREASE_DEG.to_radians().cos();
     let mut deviations = Vec::with_capacity(faces.len());
     let mut crease_deviations = Vec::new();
-    for &[a, b, c] in &faces {
+    for (i, &[a, b, c]) in faces.iter().enumerate() {
+        if i % FACES_PER_TICK == 0 {
+            tick(i as f32 / faces.len() as f32)?;
+        }
         let corners = [a, b, c].map(|v| mesh.positions[v as usize].as_dvec3());
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
         let on_surface = projector.project(centroid);
@@ -135,7 +160,7 @@ pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
     crease_deviations.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     result.crease_faces = crease_deviations.len();
     result.crease_normal_dev_deg_p95 = area_weighted_rank(&crease_deviations, 0.95);
-    result
+    Ok(result)
 }
 
 /// The smallest value with at least `fraction` of the total weight at or below it, over
