@@ -1,7 +1,8 @@
 // The evaluator's speed in the browser (the wasm build in headless Chromium timing itself with
 // measureEvaluator), the counterpart of `cargo bench --bench expr`, and the demo's click-to-shown
 // time: from a click on "mesh" to the first frame drawn after the left pane's mesh arrived, with the
-// warm worker, on the gear at res 64 (EMC left, MC right). Needs the package built
+// warm worker, on the gear at res 64 (EMC left, MC right); and how long a download's bytes take
+// (exportMesh per format on the same mesh). Needs the package built
 // (scripts/build-wasm.sh). Usage: node scripts/bench-browser.mjs [minMs] [repeats]
 import { serve, launch, packagePage, inPage } from './browser.mjs';
 
@@ -26,7 +27,19 @@ try {
     const cell = (v) => `${v.toFixed(1)} (${(r.treeWalk / v).toFixed(1)}x)`;
     console.log(`| ${r.name} | ${r.instructions} | ${r.treeWalk.toFixed(1)} | ${cell(r.value)} | ${cell(r.valueGradient)} | ${cell(r.batch)} | ${cell(r.gradientBatch)} | ${cell(r.interval)} |`);
   }
+  const exports = await inPage(page, (m) => {
+    const gear = m.meshScene('gear', { method: 'emc', res: 64 });
+    const row = { triangles: gear.stats.triangles };
+    for (const format of ['obj', 'stl', 'ply', 'glb']) {
+      const t = performance.now();
+      const bytes = m.exportMesh(gear, format);
+      row[format] = [performance.now() - t, bytes.length];
+    }
+    return row;
+  });
   await page.close();
+  console.log(`\nexportMesh on the gear (EMC res 64, ${exports.triangles} triangles), ms and bytes, on the main thread:`);
+  for (const format of ['obj', 'stl', 'ply', 'glb']) console.log(`  ${format}: ${exports[format][0].toFixed(0)} ms, ${exports[format][1]} bytes`);
   console.log();
   await clickToShown(browser, server.url);
 } finally {
