@@ -6,11 +6,12 @@
 use crate::error::Error;
 use crate::grid::Grid;
 use glam::Vec3;
-use std::cell::RefCell;
+use std::sync::Mutex;
 
 /// A scalar field over space. Implementations with an analytic gradient override [`Field::gradient`];
 /// the papers' feature detection and our vertex normals are only as good as that gradient.
-pub trait Field {
+/// `Sync` because samplers evaluate slabs of a grid on several threads at once (see [`crate::par`]).
+pub trait Field: Sync {
     fn value(&self, p: Vec3) -> f32;
 
     /// The exact gradient where the field knows it; `None` asks the caller to estimate one.
@@ -41,7 +42,7 @@ pub trait Field {
 }
 
 /// Any `Fn(Vec3) -> f32` closure is a field (without a gradient).
-impl<F: Fn(Vec3) -> f32> Field for F {
+impl<F: Fn(Vec3) -> f32 + Sync> Field for F {
     fn value(&self, p: Vec3) -> f32 {
         self(p)
     }
@@ -53,7 +54,7 @@ pub struct WithGradient<V, G> {
     pub gradient: G,
 }
 
-impl<V: Fn(Vec3) -> f32, G: Fn(Vec3) -> Vec3> Field for WithGradient<V, G> {
+impl<V: Fn(Vec3) -> f32 + Sync, G: Fn(Vec3) -> Vec3 + Sync> Field for WithGradient<V, G> {
     fn value(&self, p: Vec3) -> f32 {
         (self.value)(p)
     }
@@ -74,24 +75,30 @@ pub struct BatchFn<F> {
     f: F,
     /// Step of the central-difference gradient.
     pub step: f32,
-    error: RefCell<Option<String>>,
+    error: Mutex<Option<String>>,
 }
 
 impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> BatchFn<F> {
     pub fn new(f: F, step: f32) -> Self {
-        BatchFn { f, step, error: RefCell::new(None) }
+        BatchFn { f, step, error: Mutex::new(None) }
     }
 
     /// The first failure of the closure, if any.
     pub fn error(&self) -> Option<String> {
-        self.error.borrow().clone()
+        self.failure().clone()
+    }
+
+    /// The remembered failure; a poisoned lock (a panic while it was held) still holds a message
+    /// or `None`, both valid.
+    fn failure(&self) -> std::sync::MutexGuard<'_, Option<String>> {
+        self.error.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     fn call(&self, points: &[Vec3], out: &mut [f32]) {
-        if self.error.borrow().is_none() {
+        if self.failure().is_none() {
             match (self.f)(points, out) {
                 Ok(()) => return,
-                Err(e) => *self.error.borrow_mut() = Some(e),
+                Err(e) => *self.failure() = Some(e),
             }
         }
         out.fill(f32::NAN);
@@ -122,7 +129,7 @@ impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> BatchFn<F> {
     }
 }
 
-impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String>> Field for BatchFn<F> {
+impl<F: Fn(&[Vec3], &mut [f32]) -> Result<(), String> + Sync> Field for BatchFn<F> {
     fn value(&self, p: Vec3) -> f32 {
         let mut out = [0.0];
         self.call(&[p], &mut out);
@@ -202,64 +209,77 @@ pub fn sample_grid(field: &dyn Field, grid: &Grid) -> Result<Vec<f32>, Error> {
 /// [`Field::values`] call per tile), writing each value to `values` at the point's index; the
 /// others are left as they are. Returns how many points were evaluated. Shared by whole grids
 /// and by the crust ([`crate::crust`]).
+///
+/// A slab of tiles ([`TILE`] point layers) is a contiguous run of `values`, so slabs are sampled
+/// in parallel ([`crate::par`]), one per thread between two checkpoints of phase "sample" (so
+/// one thread checks in after every slab, as a stop asked for in the page needs).
 pub fn sample_tiles(
     field: &dyn Field,
     grid: &Grid,
-    keep: impl Fn(usize) -> bool,
+    keep: impl Fn(usize) -> bool + Sync,
     values: &mut [f32],
 ) -> Result<usize, Error> {
+    let [nx, ny, nz] = grid.points();
+    let slab_len = nx * ny * TILE;
+    let slabs_per_step = crate::par::threads();
+    let mut evaluated = 0;
+    for (step, run) in values.chunks_mut(slab_len * slabs_per_step).enumerate() {
+        let first_slab = step * slabs_per_step;
+        crate::progress::checkpoint("sample", (first_slab * TILE) as f32 / nz as f32)?;
+        let counts = crate::par::map_chunks_mut(run, slab_len, |s, slab| {
+            sample_slab(field, grid, &keep, (first_slab + s) * TILE, slab)
+        });
+        evaluated += counts.iter().sum::<usize>();
+    }
+    Ok(evaluated)
+}
+
+/// [`sample_tiles`] for the slab of tiles whose lowest point layer is `k0`, whose values are
+/// `slab` (starting at the index of point `(0, 0, k0)`).
+fn sample_slab(
+    field: &dyn Field,
+    grid: &Grid,
+    keep: &impl Fn(usize) -> bool,
+    k0: usize,
+    slab: &mut [f32],
+) -> usize {
+    let [nx, ny, nz] = grid.points();
+    let start = grid.index(0, 0, k0);
     let mut points = Vec::with_capacity(TILE * TILE * TILE);
     let mut indices = Vec::with_capacity(TILE * TILE * TILE);
     let mut out = vec![0.0f32; TILE * TILE * TILE];
     let mut evaluated = 0;
-    for_each_tile(grid.points(), "sample", |lo, hi| {
-        points.clear();
-        indices.clear();
-        for k in lo[2]..hi[2] {
-            for j in lo[1]..hi[1] {
-                for i in lo[0]..hi[0] {
-                    let n = grid.index(i, j, k);
-                    if keep(n) {
-                        points.push(grid.position(i, j, k));
-                        indices.push(n);
+    let k1 = (k0 + TILE).min(nz);
+    for j0 in (0..ny).step_by(TILE) {
+        for i0 in (0..nx).step_by(TILE) {
+            points.clear();
+            indices.clear();
+            for k in k0..k1 {
+                for j in j0..(j0 + TILE).min(ny) {
+                    for i in i0..(i0 + TILE).min(nx) {
+                        let n = grid.index(i, j, k);
+                        if keep(n) {
+                            points.push(grid.position(i, j, k));
+                            indices.push(n - start);
+                        }
                     }
                 }
             }
+            if points.is_empty() {
+                continue;
+            }
+            field.values(&points, &mut out[..points.len()]);
+            for (&n, &v) in indices.iter().zip(&out) {
+                slab[n] = v;
+            }
+            evaluated += points.len();
         }
-        if points.is_empty() {
-            return;
-        }
-        field.values(&points, &mut out[..points.len()]);
-        for (&n, &v) in indices.iter().zip(&out) {
-            values[n] = v;
-        }
-        evaluated += points.len();
-    })?;
-    Ok(evaluated)
+    }
+    evaluated
 }
 
 /// Points per side of the tiles that grids are sampled in.
 pub const TILE: usize = 8;
-
-/// Calls `visit(lo, hi)` for each tile of at most [`TILE`]³ of the `points` of a grid (index
-/// ranges, half-open), x fastest, with a [`crate::progress::checkpoint`] of `phase` before each
-/// slab of tiles.
-pub fn for_each_tile(
-    points: [usize; 3],
-    phase: &'static str,
-    mut visit: impl FnMut([usize; 3], [usize; 3]),
-) -> Result<(), Error> {
-    for k in (0..points[2]).step_by(TILE) {
-        crate::progress::checkpoint(phase, k as f32 / points[2] as f32)?;
-        for j in (0..points[1]).step_by(TILE) {
-            for i in (0..points[0]).step_by(TILE) {
-                let lo = [i, j, k];
-                visit(lo, [0, 1, 2].map(|a| (lo[a] + TILE).min(points[a])));
-            }
-        }
-    }
-    Ok(())
-}
 
 /// Fails with [`Error::NonFiniteSample`] naming the first NaN or infinite sample, and with
 /// [`Error::InvalidGrid`] for the first past [`MAX_SAMPLE_MAGNITUDE`].
@@ -456,10 +476,10 @@ mod tests {
     #[test]
     fn batch_fn_samples_one_slab_per_call_and_reports_failures() {
         let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [8, 8, 8]).unwrap();
-        let calls = std::cell::Cell::new(0);
+        let calls = std::sync::atomic::AtomicUsize::new(0);
         let sphere = BatchFn::new(
             |pts: &[Vec3], out: &mut [f32]| {
-                calls.set(calls.get() + 1);
+                calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 for (p, o) in pts.iter().zip(out) {
                     *o = p.length() - 0.7;
                 }
@@ -468,7 +488,7 @@ mod tests {
             1e-3,
         );
         let values = sphere.sample(&grid).unwrap();
-        assert_eq!(calls.get(), 9);
+        assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 9);
         assert_eq!(values, sample_grid(&|p: Vec3| p.length() - 0.7, &grid).unwrap());
         let g = sphere.gradient(Vec3::new(0.3, 0.4, 0.0)).unwrap();
         assert!((g - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-2, "{g}");

@@ -31,6 +31,7 @@
 //! - [`quad`]: semi-regular quad meshes from the outside faces of cut cells, with collapses.
 //! - [`scenes`]: named test objects shared by the CLI, tests, benches and the demo.
 //! - [`stats`]: the one JSON-able summary of a meshing run.
+//! - [`par`]: threads natively (rayon), the same loops in order in wasm; same output either way.
 //!
 //! The algorithm core knows nothing of JavaScript; `wasm` (only on wasm32) is a thin binding layer.
 
@@ -45,6 +46,7 @@ pub mod input;
 pub mod mc;
 pub mod mcq;
 pub mod mesh;
+pub mod par;
 pub mod pipeline;
 pub mod progress;
 pub mod quad;

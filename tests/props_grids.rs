@@ -67,8 +67,13 @@ impl Case {
 /// A random grid of 3–`max_points` points per axis, with non-cubic spacing and an origin away
 /// from zero, filled with one [`Kind`] of values and padded on half of the seeds.
 fn generate(seed: u64, max_points: usize) -> Case {
+    generate_in(seed, [max_points; 3])
+}
+
+/// [`generate`] with its own largest point count per axis.
+fn generate_in(seed: u64, max_points: [usize; 3]) -> Case {
     let mut rng = Rng::new(seed);
-    let points: [usize; 3] = std::array::from_fn(|_| 3 + rng.below(max_points as u64 - 2) as usize);
+    let points: [usize; 3] = std::array::from_fn(|a| 3 + rng.below(max_points[a] as u64 - 2) as usize);
     let spacing = Vec3::new(rng.range(0.2, 3.0), rng.range(0.2, 3.0), rng.range(0.2, 3.0));
     let origin = Vec3::new(rng.range(-10.0, 10.0), rng.range(-10.0, 10.0), rng.range(-10.0, 10.0));
     let grid = Grid::from_points(points, origin, spacing).unwrap();
@@ -265,6 +270,22 @@ const CI_CASES: usize = 120;
 fn for_cases(seed_base: u64, max_points: usize, mut check: impl FnMut(u64, &Case)) {
     for seed in case_seeds(seed_base, CI_CASES) {
         check(seed, &generate(seed, max_points));
+    }
+}
+
+/// MC extracts slabs of cell layers in parallel and joins them: on grids tall enough for several
+/// slabs, the mesh is sound and the same, vertex for vertex, with one thread or three.
+#[test]
+fn prop_mc_is_the_same_mesh_on_one_thread_or_three() {
+    for seed in case_seeds(9_000_000, CI_CASES) {
+        let case = generate_in(seed, [9, 9, 70]);
+        for topology in [Topology::Fixed, Topology::Trilinear] {
+            let what = format!("seed {seed} mc {topology:?}");
+            let one = isoforge::par::with_threads(1, || mesh(&case, Method::Mc, topology));
+            let three = isoforge::par::with_threads(3, || mesh(&case, Method::Mc, topology));
+            assert_sound(&case, &three, &what);
+            assert!(one == three, "{what}: {}: the meshes differ", case.describe());
+        }
     }
 }
 

@@ -94,6 +94,10 @@ struct MeshArgs {
     /// Refuse grids with more cells than this.
     #[arg(long, default_value_t = isoforge::grid::DEFAULT_MAX_CELLS)]
     max_cells: u64,
+    /// Threads for sampling and Marching Cubes' slabs (default: one per core); the mesh is the
+    /// same for every count.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     /// Output file; the format follows the extension (.obj, .stl, .ply, .glb).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -193,6 +197,9 @@ fn main() -> ExitCode {
 }
 
 fn mesh(args: MeshArgs) -> Result<(), Error> {
+    if let Some(n) = args.threads {
+        isoforge::par::set_threads(n)?;
+    }
     let defaults = PolygonRules::default();
     let request = Request {
         method: Method::parse(&args.method)?,

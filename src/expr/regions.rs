@@ -61,6 +61,13 @@ const WORTH_BUILDING: u32 = 16;
 /// Tapes shorter than this are not specialised further.
 const SHORT_TAPE: usize = 48;
 
+/// Batches of this many points or more are evaluated in pieces on several threads.
+const PARALLEL_BATCH: usize = 8192;
+
+/// Points per piece of a parallel batch: a piece is still a long batch (its per-call costs,
+/// grouping by brick, are small beside it), and a batch of `PARALLEL_BATCH` makes two.
+const PIECE: usize = PARALLEL_BATCH / 2;
+
 impl<'a> RegionalProgram<'a> {
     /// Specialises `full` over the box `lo..hi` down to `depth` levels (at most [`MAX_DEPTH`]).
     pub fn new(full: &'a Program, lo: Vec3, hi: Vec3, depth: u8) -> RegionalProgram<'a> {
@@ -206,11 +213,33 @@ impl<'a> RegionalProgram<'a> {
 
     /// Runs `eval` on each group of `points` that share a leaf brick, through that brick's tape;
     /// `out[i]` gets point `i`'s result.
-    fn batched<O: Copy + Default>(
+    ///
+    /// A batch of [`PARALLEL_BATCH`] points or more (DMC's sample lattice, its root finding and
+    /// distance tests) is cut into pieces of [`PIECE`] evaluated on several threads
+    /// ([`crate::par`]): a point's result depends only on the point (every brick's tape gives the
+    /// full tape's values), so the pieces change nothing but the time.
+    fn batched<O: Copy + Default + Send>(
         &self,
         points: &[Vec3],
         out: &mut [O],
-        eval: impl Fn(&Program, &[Vec3], &mut [O]),
+        eval: impl Fn(&Program, &[Vec3], &mut [O]) + Sync + Send,
+    ) {
+        let n = points.len().min(out.len());
+        if n >= PARALLEL_BATCH {
+            crate::par::map_chunks_mut(&mut out[..n], PIECE, |c, piece| {
+                self.batched_by_brick(&points[c * PIECE..c * PIECE + piece.len()], piece, &eval)
+            });
+        } else {
+            self.batched_by_brick(&points[..n], &mut out[..n], &eval);
+        }
+    }
+
+    /// [`RegionalProgram::batched`] on this thread.
+    fn batched_by_brick<O: Copy + Default>(
+        &self,
+        points: &[Vec3],
+        out: &mut [O],
+        eval: &impl Fn(&Program, &[Vec3], &mut [O]),
     ) {
         let n = points.len().min(out.len());
         if self.depth == 0 {

@@ -97,9 +97,11 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
         None => sample_grid(field, grid)?,
     };
     timings.sample_ms = ms_since(t0);
+    crate::progress::checkpoint("extract", 0.0)?;
     let t1 = Instant::now();
     let mut mesh = extract(&values, grid, options)?;
     timings.extract_ms = ms_since(t1);
+    crate::progress::checkpoint("normals", 0.0)?;
     let t2 = Instant::now();
     set_normals(&mut mesh, field);
     timings.normals_ms = ms_since(t2);
@@ -109,11 +111,10 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
 /// Vertex normals from the field's gradient where it has one, else from the faces.
 pub(crate) fn set_normals(mesh: &mut Mesh, field: &dyn Field) {
     if mesh.positions.first().is_some_and(|&p| field.gradient(p).is_some()) {
-        mesh.normals = mesh
-            .positions
-            .iter()
-            .map(|&p| field.gradient(p).unwrap_or(Vec3::ZERO).normalize_or_zero())
-            .collect();
+        let positions = &mesh.positions;
+        mesh.normals = crate::par::map(positions.len(), |v| {
+            field.gradient(positions[v]).unwrap_or(Vec3::ZERO).normalize_or_zero()
+        });
     } else {
         mesh.compute_normals_from_faces();
     }
@@ -178,19 +179,36 @@ pub(crate) struct EdgeCache {
     /// x- and y-edges of the lower and upper layer: `[layer][axis][i + nx * j]`.
     layer_edges: [[Vec<u32>; 2]; 2],
     z_edges: Vec<u32>,
+    /// The x- and y-edges of the first layer, kept when the sweep leaves it (for joining slabs).
+    first_layer: Option<[Vec<u32>; 2]>,
 }
 
 impl EdgeCache {
     pub(crate) fn new(nx: usize, ny: usize) -> Self {
         let plane = || vec![NONE; nx * ny];
-        EdgeCache { nx, layer_edges: [[plane(), plane()], [plane(), plane()]], z_edges: plane() }
+        EdgeCache {
+            nx,
+            layer_edges: [[plane(), plane()], [plane(), plane()]],
+            z_edges: plane(),
+            first_layer: None,
+        }
     }
 
     pub(crate) fn advance(&mut self) {
         self.layer_edges.swap(0, 1);
+        if self.first_layer.is_none() {
+            let fresh = [vec![NONE; self.z_edges.len()], vec![NONE; self.z_edges.len()]];
+            self.first_layer = Some(std::mem::replace(&mut self.layer_edges[1], fresh));
+        }
         for plane in self.layer_edges[1].iter_mut().chain(std::iter::once(&mut self.z_edges)) {
             plane.fill(NONE);
         }
+    }
+
+    /// The x- and y-edge ids of the sweep's first and last point layers.
+    fn into_outer_layers(self) -> ([Vec<u32>; 2], [Vec<u32>; 2]) {
+        let [lower, upper] = self.layer_edges;
+        (self.first_layer.unwrap_or(lower), upper)
     }
 
     /// The slot of cell-local edge `e` of the cell whose lowest corner is `(i, j)` in the current slab.
@@ -205,16 +223,73 @@ impl EdgeCache {
     }
 }
 
+/// Cell layers per slab of [`extract`]: fixed, so the output does not depend on the threads.
+const SLAB_LAYERS: usize = 16;
+
 /// Extracts the `options.iso` level set of a sampled grid.
+///
+/// Slabs of [`SLAB_LAYERS`] cell layers are extracted in parallel ([`crate::par`]), each with
+/// vertex ids of its own, then joined in order: a slab's vertices on its lowest point layer are
+/// the ones the slab below made on its highest (both made them from the same two samples, so they
+/// are the same points), and the rest keep the order they were made in. That is exactly the mesh
+/// one sweep over the whole grid makes, vertex for vertex, whatever the number of threads.
 pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh, Error> {
     check_finite(values, grid)?;
+    let cz = grid.cells[2];
+    let slabs = crate::par::map(cz.div_ceil(SLAB_LAYERS), |s| {
+        let layers = s * SLAB_LAYERS..((s + 1) * SLAB_LAYERS).min(cz);
+        extract_slab(values, grid, options, layers)
+    });
+    Ok(join_slabs(slabs))
+}
+
+/// A slab's mesh and the ids its edge cache gave the x and y edges of its lowest and highest
+/// point layers (`[axis][i + nx * j]`, [`NONE`] where the level does not cross).
+struct Slab {
+    mesh: Mesh,
+    bottom: [Vec<u32>; 2],
+    top: [Vec<u32>; 2],
+}
+
+/// The slabs' meshes as one, their shared vertices merged (see [`extract`]).
+fn join_slabs(slabs: Vec<Slab>) -> Mesh {
+    let mut mesh = Mesh::default();
+    let mut below_top: Option<[Vec<u32>; 2]> = None;
+    for slab in slabs {
+        let mut global = vec![NONE; slab.mesh.positions.len()];
+        if let Some(top) = &below_top {
+            for (bottom, top) in slab.bottom.iter().zip(top) {
+                for (&local, &shared) in bottom.iter().zip(top) {
+                    if local != NONE {
+                        debug_assert_ne!(shared, NONE, "a crossed edge made by one slab only");
+                        global[local as usize] = shared;
+                    }
+                }
+            }
+        }
+        for (id, &p) in global.iter_mut().zip(&slab.mesh.positions) {
+            if *id == NONE {
+                *id = mesh.positions.len() as u32;
+                mesh.positions.push(p);
+            }
+        }
+        mesh.triangles.extend(slab.mesh.triangles.iter().map(|t| t.map(|v| global[v as usize])));
+        below_top = Some(slab.top.map(|plane| {
+            plane.into_iter().map(|v| if v == NONE { NONE } else { global[v as usize] }).collect()
+        }));
+    }
+    mesh
+}
+
+/// Extracts the cells of the layers `layers` (cell z indices) with vertex ids of their own.
+fn extract_slab(values: &[f32], grid: &Grid, options: &McOptions, layers: std::ops::Range<usize>) -> Slab {
     let iso = options.iso;
     let mut mesh = Mesh::default();
     let fixed = triangle_table();
     // The 16 384-entry table is built only when the trilinear option asks for it.
     let with_faces: &[CellTriangles] =
         if options.topology == Topology::Trilinear { triangle_table_with_faces() } else { &[] };
-    for_each_crossed_cell(values, grid, iso, |ijk, case, d, cache| {
+    let cache = for_each_crossed_cell_in(values, grid, iso, layers, |ijk, case, d, cache| {
         let mut cell = Cell { grid, ijk, d, ids: [NONE; 13] };
         let tris: &CellTriangles = match options.topology {
             Topology::Fixed => &fixed[case as usize],
@@ -241,7 +316,8 @@ pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh,
             cell.emit_untangled(poly, group, cache, &mut mesh);
         }
     });
-    Ok(mesh)
+    let (bottom, top) = cache.into_outer_layers();
+    Slab { mesh, bottom, top }
 }
 
 /// Visits every cell the `iso` level crosses in the sweep order [`EdgeCache`] needs, with the
@@ -252,14 +328,27 @@ pub(crate) fn for_each_crossed_cell(
     values: &[f32],
     grid: &Grid,
     iso: f32,
-    mut visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
+    visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
 ) {
+    for_each_crossed_cell_in(values, grid, iso, 0..grid.cells[2], visit);
+}
+
+/// [`for_each_crossed_cell`] over the cell layers `layers` (z indices) alone; returns the cache,
+/// which holds the ids of the edges of the range's highest point layer (and its first one's).
+fn for_each_crossed_cell_in(
+    values: &[f32],
+    grid: &Grid,
+    iso: f32,
+    layers: std::ops::Range<usize>,
+    mut visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
+) -> EdgeCache {
     let [nx, ny, _] = grid.points();
-    let [cx, cy, cz] = grid.cells;
+    let [cx, cy, _] = grid.cells;
     let mut cache = EdgeCache::new(nx, ny);
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
-    for k in 0..cz {
-        if k > 0 {
+    let first = layers.start;
+    for k in layers {
+        if k > first {
             cache.advance();
         }
         for j in 0..cy {
@@ -276,6 +365,7 @@ pub(crate) fn for_each_crossed_cell(
             }
         }
     }
+    cache
 }
 
 /// The vertex on cell edge `e` of `cell` (values `d`): looked up in the cache, or placed by
@@ -496,4 +586,52 @@ pub(crate) fn joined_faces(case: u8, d: &[f32; 8]) -> u8 {
         }
     }
     bits
+}
+
+#[cfg(test)]
+mod slab_tests {
+    use super::*;
+
+    /// The slabs joined are exactly one sweep over the whole grid (see [`extract`]), on tall random
+    /// grids of several slabs, in both topologies, with one thread or several.
+    #[test]
+    fn joined_slabs_are_one_sweep_vertex_for_vertex() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for round in 0..40 {
+            let points =
+                [3 + (next() * 8.0) as usize, 3 + (next() * 8.0) as usize, 2 + (next() * 60.0) as usize];
+            let grid = Grid::from_points(points, Vec3::splat(-1.0), Vec3::new(0.3, 0.25, 0.2)).unwrap();
+            // Smooth blobs on odd rounds (long crossing sheets through the slab seams), noise on even.
+            let values: Vec<f32> = (0..grid.point_count())
+                .map(|n| {
+                    let [i, j, k] = grid.unindex(n);
+                    if round % 2 == 1 {
+                        (grid.position(i, j, k) * Vec3::new(2.0, 3.0, 0.4))
+                            .to_array()
+                            .iter()
+                            .map(|v| v.sin())
+                            .sum::<f32>()
+                            + next() * 0.3
+                    } else {
+                        next() - 0.5
+                    }
+                })
+                .collect();
+            for topology in [Topology::Fixed, Topology::Trilinear] {
+                let options = McOptions { topology, ..McOptions::default() };
+                let sweep = join_slabs(vec![extract_slab(&values, &grid, &options, 0..grid.cells[2])]);
+                for threads in [1, 3] {
+                    let joined =
+                        crate::par::with_threads(threads, || extract(&values, &grid, &options).unwrap());
+                    assert!(joined == sweep, "round {round}, {points:?}, {topology:?}, {threads} threads");
+                }
+            }
+        }
+    }
 }

@@ -1,0 +1,103 @@
+//! Data parallelism where the platform has threads: natively on rayon's pool, in wasm (one thread,
+//! no shared memory) as the same loops run in order.
+//!
+//! Every parallel section here hands out fixed pieces of work (slabs of a grid, chunks of a list)
+//! whose results are put together in the pieces' order, and how the work is cut never depends on
+//! how many threads there are: the output is the same bit for bit with one thread or many.
+//!
+//! Progress checkpoints ([`crate::progress`]) are thread-local: the callers keep them outside the
+//! closures given here, between parallel sections, on the job's own thread.
+
+/// `f(0), f(1), …, f(n - 1)`, in that order, computed in parallel where there are threads.
+pub fn map<R: Send>(n: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().map(f).collect()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        (0..n).map(f).collect()
+    }
+}
+
+/// Calls `f(chunk_index, chunk)` for each `chunk_len`-long piece of `data` (the last may be
+/// shorter), in parallel where there are threads, and returns the results in chunk order.
+pub fn map_chunks_mut<T: Send, R: Send>(
+    data: &mut [T],
+    chunk_len: usize,
+    f: impl Fn(usize, &mut [T]) -> R + Sync + Send,
+) -> Vec<R> {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use rayon::prelude::*;
+        data.par_chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        data.chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect()
+    }
+}
+
+/// Threads the parallel sections can use (1 in wasm).
+pub fn threads() -> usize {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        rayon::current_num_threads()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        1
+    }
+}
+
+/// Sets how many threads the parallel sections use from now on, for the whole process (the
+/// CLI's `--threads`); rayon's default is one per core. Only the first call can take effect.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn set_threads(n: usize) -> Result<(), crate::Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n.max(1))
+        .build_global()
+        .map_err(|e| crate::Error::InvalidOption(format!("cannot set the thread count: {e}")))
+}
+
+/// Runs `job` with the parallel sections on a pool of `n` threads of its own (`job` itself runs on
+/// one of them, so a progress hook of the calling thread does not see its checkpoints): for
+/// comparing thread counts, and for the CLI's `--threads`. In wasm, runs `job` as it is.
+pub fn with_threads<R: Send>(n: usize, job: impl FnOnce() -> R + Send) -> R {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        match rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build() {
+            Ok(pool) => pool.install(job),
+            // No threads to be had (a sandbox that forbids them): the calling thread does it all.
+            Err(_) => job(),
+        }
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = n;
+        job()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn results_come_in_order_whatever_the_thread_count() {
+        for threads in [1, 2, 5] {
+            let squares = with_threads(threads, || map(100, |i| i * i));
+            assert_eq!(squares, (0..100).map(|i| i * i).collect::<Vec<_>>());
+            let mut data: Vec<usize> = (0..23).collect();
+            let sums = with_threads(threads, || {
+                map_chunks_mut(&mut data, 5, |i, chunk| {
+                    chunk.iter_mut().for_each(|v| *v += 100 * i);
+                    chunk.len()
+                })
+            });
+            assert_eq!(sums, vec![5, 5, 5, 5, 3]);
+            assert_eq!(data[22], 22 + 400);
+        }
+    }
+}
