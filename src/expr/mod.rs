@@ -84,7 +84,9 @@ pub use ast::Script;
 pub use builtins::{Arity, Builtin};
 pub use csg::CsgNode;
 pub use diag::Span;
+pub use graph::{Node, NodeId};
 pub use interval::Choice;
+pub use ops::{BinaryOp, UnaryOp};
 pub use program::Program;
 pub use regions::{RegionalProgram, TapeLengths};
 

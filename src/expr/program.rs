@@ -154,6 +154,13 @@ impl Program {
     }
 
     /// Instructions on the tape (constants and coordinate loads not counted).
+    /// The program as a graph: nodes in evaluation order (every operand before its readers),
+    /// constants folded and repeated subexpressions shared, and the node that is the result. For
+    /// handing a program to another evaluator (the benchmarks against peer meshers do).
+    pub fn nodes(&self) -> (&[Node], NodeId) {
+        (&self.nodes, self.root)
+    }
+
     pub fn instruction_count(&self) -> usize {
         self.tape.instrs.len()
     }
