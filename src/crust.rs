@@ -27,55 +27,103 @@ pub struct CrustSamples {
 /// interval bounds (then the caller samples every point).
 pub fn sample_crust(field: &dyn Field, grid: &Grid, iso: f32) -> Option<Result<CrustSamples, Error>> {
     field.interval(grid.origin, grid.origin + grid.spacing)?;
-    let mut state = Traversal {
-        field,
-        grid,
-        iso,
-        values: vec![f32::NAN; grid.point_count()],
-        marked: vec![false; grid.point_count()],
-        interval_queries: 0,
-    };
-    state.visit([0, 0, 0], grid.cells);
-    Some(state.finish())
+    let traversal = Traversal { field, grid, iso };
+    let (boxes, interval_queries) = traversal.boxes([0, 0, 0], grid.cells);
+    let mut samples =
+        Samples { grid, values: vec![f32::NAN; grid.point_count()], marked: vec![false; grid.point_count()] };
+    for b in boxes {
+        match b {
+            Decided::Fill { lo, hi, value } => samples.fill(lo, hi, value),
+            Decided::Surface { lo, hi } => samples.mark(lo, hi),
+        }
+    }
+    Some(samples.finish(field, interval_queries))
 }
+
+/// What the traversal decided for a box of cells (indices, half-open).
+enum Decided {
+    /// The level is outside the interval bound: every point has `value`'s sign.
+    Fill { lo: [usize; 3], hi: [usize; 3], value: f32 },
+    /// A box of a few cells that may hold the surface: its points are evaluated.
+    Surface { lo: [usize; 3], hi: [usize; 3] },
+}
+
+/// Boxes of more cells than this are split with their halves bounded on two threads.
+const PARALLEL_CELLS: usize = 32 * 32 * 32;
 
 struct Traversal<'a> {
     field: &'a dyn Field,
     grid: &'a Grid,
     iso: f32,
-    values: Vec<f32>,
-    /// Points that are corners of a cell that may hold the surface.
-    marked: Vec<bool>,
-    interval_queries: usize,
 }
 
 impl Traversal<'_> {
-    /// Visits the cells `lo .. hi` (cell indices, half-open).
-    fn visit(&mut self, lo: [usize; 3], hi: [usize; 3]) {
+    /// The decided boxes of the cells `lo .. hi`, in depth-first order (lower halves first), and
+    /// the interval queries made. Large boxes' halves are bounded in parallel ([`crate::par`]);
+    /// their lists are joined in that same order, so the samples do not depend on the threads.
+    fn boxes(&self, lo: [usize; 3], hi: [usize; 3]) -> (Vec<Decided>, usize) {
+        let cells: usize = (0..3).map(|a| hi[a] - lo[a]).product();
+        if cells <= PARALLEL_CELLS {
+            let mut out = Vec::new();
+            let queries = self.visit(lo, hi, &mut out);
+            return (out, queries);
+        }
+        match self.decide(lo, hi) {
+            Err(decided) => (vec![decided], 1),
+            Ok((left, right)) => {
+                let ((mut a, qa), (b, qb)) =
+                    crate::par::join(|| self.boxes(lo, left), || self.boxes(right, hi));
+                a.extend(b);
+                (a, 1 + qa + qb)
+            }
+        }
+    }
+
+    /// [`Traversal::boxes`] on this thread, appending to `out`; returns the interval queries made.
+    fn visit(&self, lo: [usize; 3], hi: [usize; 3], out: &mut Vec<Decided>) -> usize {
+        match self.decide(lo, hi) {
+            Err(decided) => {
+                out.push(decided);
+                1
+            }
+            Ok((left, right)) => 1 + self.visit(lo, left, out) + self.visit(right, hi, out),
+        }
+    }
+
+    /// Bounds the box: decided (`Err`), or split in two along its longest side (the lower half's
+    /// `hi` and the upper half's `lo`).
+    #[allow(clippy::type_complexity)]
+    fn decide(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<([usize; 3], [usize; 3]), Decided> {
         let (wlo, whi) = (self.grid.position(lo[0], lo[1], lo[2]), self.grid.position(hi[0], hi[1], hi[2]));
-        self.interval_queries += 1;
         let (vlo, vhi) = self.field.interval(wlo, whi).unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
         // The bound itself stands in (not `bound - iso + iso`, which may round onto the level).
         if vlo > self.iso || vhi < self.iso {
-            self.fill(lo, hi, if vlo > self.iso { vlo } else { vhi });
-            return;
+            return Err(Decided::Fill { lo, hi, value: if vlo > self.iso { vlo } else { vhi } });
         }
         let sizes = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
         let axis = (0..3).max_by_key(|&a| sizes[a]).expect("three axes");
         // Below a few cells a box is cheaper to sample densely (batched, vectorised evaluation)
         // than to keep bounding (each interval query costs about as much as a dozen points).
         if sizes[axis] <= LEAF_CELLS {
-            self.mark(lo, hi);
-            return;
+            return Err(Decided::Surface { lo, hi });
         }
         let mid = lo[axis] + sizes[axis] / 2;
         let (mut left_hi, mut right_lo) = (hi, lo);
         left_hi[axis] = mid;
         right_lo[axis] = mid;
-        self.visit(lo, left_hi);
-        self.visit(right_lo, hi);
+        Ok((left_hi, right_lo))
     }
+}
 
+/// The grid's samples while the decided boxes are applied.
+struct Samples<'a> {
+    grid: &'a Grid,
+    values: Vec<f32>,
+    /// Points that are corners of a cell that may hold the surface.
+    marked: Vec<bool>,
+}
+
+impl Samples<'_> {
     /// Gives every point of the closed box a value of the known sign (evaluated points keep theirs).
     fn fill(&mut self, lo: [usize; 3], hi: [usize; 3], value: f32) {
         for k in lo[2]..=hi[2] {
@@ -103,11 +151,11 @@ impl Traversal<'_> {
 
     /// Evaluates the marked points tile by tile ([`crate::field::sample_tiles`]; they overwrite
     /// stand-ins) and checks them.
-    fn finish(mut self) -> Result<CrustSamples, Error> {
+    fn finish(mut self, field: &dyn Field, interval_queries: usize) -> Result<CrustSamples, Error> {
         let marked = &self.marked;
-        let evaluated = crate::field::sample_tiles(self.field, self.grid, |n| marked[n], &mut self.values)?;
+        let evaluated = crate::field::sample_tiles(field, self.grid, |n| marked[n], &mut self.values)?;
         crate::field::check_finite(&self.values, self.grid)?;
-        Ok(CrustSamples { values: self.values, evaluated, interval_queries: self.interval_queries })
+        Ok(CrustSamples { values: self.values, evaluated, interval_queries })
     }
 }
 
@@ -147,6 +195,23 @@ mod tests {
             }
         }
         assert!(crossed > 1000);
+    }
+
+    /// Large boxes are bounded on several threads; the samples, bit for bit, and the count of
+    /// queries are those of one thread.
+    #[test]
+    fn the_crust_is_the_same_on_one_thread_or_three() {
+        let gear = crate::scenes::scene("gear").unwrap();
+        let grid = Grid::with_resolution(gear.min, gear.max, 96).unwrap();
+        let run = |threads| {
+            crate::par::with_threads(threads, || {
+                sample_crust(gear.field.as_ref(), &grid, 0.0).unwrap().unwrap()
+            })
+        };
+        let (one, three) = (run(1), run(3));
+        assert!(one.values.iter().zip(&three.values).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert_eq!((one.evaluated, one.interval_queries), (three.evaluated, three.interval_queries));
+        assert!(one.interval_queries > 100, "{} queries", one.interval_queries);
     }
 
     #[test]

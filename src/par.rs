@@ -39,6 +39,18 @@ pub fn map_chunks_mut<T: Send, R: Send>(
     }
 }
 
+/// `(a(), b())`, the two on different threads where there are threads to spare.
+pub fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        rayon::join(a, b)
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        (a(), b())
+    }
+}
+
 /// Threads the parallel sections can use (1 in wasm).
 pub fn threads() -> usize {
     #[cfg(not(target_arch = "wasm32"))]
