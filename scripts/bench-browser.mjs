@@ -2,7 +2,8 @@
 // measureEvaluator), the counterpart of `cargo bench --bench expr`, and the demo's click-to-shown
 // time: from a click on "mesh" to the first frame drawn after the left pane's mesh arrived, with the
 // warm worker, on the gear at res 64 (EMC left, MC right); and how long a download's bytes take
-// (exportMesh per format on the same mesh). Needs the package built
+// (exportMesh per format on the same mesh); and MC's extraction on a sampled sphere, the
+// counterpart of `cargo bench --bench marching_cubes`. Needs the package built
 // (scripts/build-wasm.sh). Usage: node scripts/bench-browser.mjs [minMs] [repeats]
 import { serve, launch, packagePage, inPage } from './browser.mjs';
 
@@ -37,7 +38,23 @@ try {
     }
     return row;
   });
+  const grids = await inPage(page, (m) => [128, 256].map((n) => {
+    // The sampled sphere of `cargo bench --bench marching_cubes` (radius 0.8 in [-1, 1]³, n cells).
+    const values = new Float32Array((n + 1) ** 3);
+    let at = 0;
+    for (let k = 0; k <= n; k++) for (let j = 0; j <= n; j++) for (let i = 0; i <= n; i++) {
+      const [x, y, z] = [i, j, k].map((v) => -1 + (2 * v) / n);
+      values[at++] = Math.hypot(x, y, z) - 0.8;
+    }
+    const extract = [];
+    for (let r = 0; r < 5; r++) {
+      extract.push(m.meshGrid(values, [n + 1, n + 1, n + 1], [-1, -1, -1, 1, 1, 1], { method: 'mc' }).stats.phases_ms.extract);
+    }
+    return { n, extract: extract.sort((a, b) => a - b)[2] };
+  }));
   await page.close();
+  console.log('\nMC extraction on a sampled sphere (meshGrid, median of 5):');
+  for (const g of grids) console.log(`  ${g.n}³: ${g.extract.toFixed(1)} ms`);
   console.log(`\nexportMesh on the gear (EMC res 64, ${exports.triangles} triangles), ms and bytes, on the main thread:`);
   for (const format of ['obj', 'stl', 'ply', 'glb']) console.log(`  ${format}: ${exports[format][0].toFixed(0)} ms, ${exports[format][1]} bytes`);
   console.log();
