@@ -9,7 +9,8 @@ use crate::mc::MIN_EDGE_FRACTION;
 use glam::Vec3;
 
 /// A source of EMC's edge samples: where the surface crosses a grid edge, and its normal there.
-pub trait EdgeSampler {
+/// `Sync` because EMC's slabs ask one sampler from several threads (see [`crate::par`]).
+pub trait EdgeSampler: Sync {
     /// The crossing on the segment `a → b`, whose end values (minus the iso-level) `da`, `db` have
     /// opposite signs, as the fraction `t` of the way from `a`, and the unit outward normal there.
     fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3);

@@ -261,14 +261,103 @@ fn crossing(
     (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
 }
 
+/// The grid's cells in slabs of [`SLAB_LAYERS`] cell layers, a few at a time in parallel
+/// ([`crate::par`], one per thread between checkpoints), joined as Marching Cubes joins its slabs
+/// ([`crate::mc::extract`]): a slab's vertices on its lowest point layer are the slab below's, so
+/// the mesh is the one sweep's, vertex for vertex, whatever the threads. A crossing on a shared
+/// layer is computed by both slabs from the same edge and samples, so both decide their cells
+/// with the same point.
 fn extract(
     values: &[f32],
     grid: &Grid,
     options: &EmcOptions,
     sampler: &dyn EdgeSampler,
 ) -> Result<(EmcMesh, FanCentres, Vec<OutsideFan>), Error> {
+    let cz = grid.cells[2];
+    let slabs = cz.div_ceil(SLAB_LAYERS);
+    let per_step = crate::par::threads();
+    let mut parts = Vec::with_capacity(slabs);
+    for first in (0..slabs).step_by(per_step) {
+        crate::progress::checkpoint("extract", (first * SLAB_LAYERS) as f32 / cz as f32)?;
+        parts.extend(crate::par::map(per_step.min(slabs - first), |s| {
+            let start = (first + s) * SLAB_LAYERS;
+            extract_slab(values, grid, options, sampler, start..(start + SLAB_LAYERS).min(cz))
+        }));
+    }
+    Ok(join_slabs(parts))
+}
+
+/// Cell layers per slab of [`extract`]: fixed, so the output does not depend on the threads.
+const SLAB_LAYERS: usize = 16;
+
+/// One slab's output, its vertex ids its own; `bottom` and `top` are the ids its edge cache gave
+/// the x and y edges of its lowest and highest point layers.
+struct Slab {
+    out: EmcMesh,
+    normals: Vec<Vec3>,
+    centres: FanCentres,
+    outside: Vec<OutsideFan>,
+    bottom: [Vec<u32>; 2],
+    top: [Vec<u32>; 2],
+}
+
+/// The slabs as one mesh, each slab's lowest-layer vertices merged into the slab below's.
+fn join_slabs(slabs: Vec<Slab>) -> (EmcMesh, FanCentres, Vec<OutsideFan>) {
+    let mut out = EmcMesh::default();
+    let mut normals = Vec::new();
+    let mut centres = FanCentres::default();
+    let mut outside = Vec::new();
+    let mut below_top: Option<[Vec<u32>; 2]> = None;
+    for slab in slabs {
+        let mut global = vec![NONE; slab.out.mesh.positions.len()];
+        if let Some(top) = &below_top {
+            for (bottom, top) in slab.bottom.iter().zip(top) {
+                for (&local, &shared) in bottom.iter().zip(top) {
+                    if local != NONE {
+                        debug_assert_eq!(
+                            slab.out.mesh.positions[local as usize], out.mesh.positions[shared as usize],
+                            "a crossing placed differently by two slabs"
+                        );
+                        global[local as usize] = shared;
+                    }
+                }
+            }
+        }
+        for (v, id) in global.iter_mut().enumerate() {
+            if *id == NONE {
+                *id = out.mesh.positions.len() as u32;
+                out.mesh.positions.push(slab.out.mesh.positions[v]);
+                normals.push(slab.normals[v]);
+                out.feature_vertex.push(slab.out.feature_vertex[v]);
+                centres.push(slab.centres.any[v], slab.centres.on_feature[v]);
+            }
+        }
+        out.mesh.triangles.extend(slab.out.mesh.triangles.iter().map(|t| t.map(|v| global[v as usize])));
+        outside.extend(
+            slab.outside.into_iter().map(|fan| OutsideFan { vertex: global[fan.vertex as usize], ..fan }),
+        );
+        out.edge_features += slab.out.edge_features;
+        out.corner_features += slab.out.corner_features;
+        out.approximate_features += slab.out.approximate_features;
+        out.rejected_features += slab.out.rejected_features;
+        below_top = Some(slab.top.map(|plane| {
+            plane.into_iter().map(|v| if v == NONE { NONE } else { global[v as usize] }).collect()
+        }));
+    }
+    out.mesh.normals = normals;
+    (out, centres, outside)
+}
+
+/// EMC on the cell layers `layers` (z indices), with vertex ids of the slab's own.
+fn extract_slab(
+    values: &[f32],
+    grid: &Grid,
+    options: &EmcOptions,
+    sampler: &dyn EdgeSampler,
+    layers: std::ops::Range<usize>,
+) -> Slab {
     let [nx, ny, _] = grid.points();
-    let [cx, cy, cz] = grid.cells;
+    let [cx, cy, _] = grid.cells;
     let mut out = EmcMesh::default();
     let mut cache = EdgeCache::new(nx, ny);
     let (fixed, fixed_tris) = (polygon_table(), triangle_table());
@@ -281,9 +370,9 @@ fn extract(
     let mut outside_fans: Vec<OutsideFan> = Vec::new();
     let mut centres = FanCentres::default();
 
-    for k in 0..cz {
-        crate::progress::checkpoint("extract", k as f32 / cz as f32)?;
-        if k > 0 {
+    let first = layers.start;
+    for k in layers {
+        if k > first {
             cache.advance();
         }
         for j in 0..cy {
@@ -418,8 +507,8 @@ fn extract(
             }
         }
     }
-    out.mesh.normals = normals_of_vertex;
-    Ok((out, centres, outside_fans))
+    let (bottom, top) = cache.into_outer_layers();
+    Slab { out, normals: normals_of_vertex, centres, outside: outside_fans, bottom, top }
 }
 
 /// Per vertex: is it the centre of a feature fan (on the feature or approximately), and is it on
@@ -471,3 +560,65 @@ fn pull_back(
 /// paper's tangent-plane points, `resample_creases: false`, are not checked: on curved creases
 /// they err by O(h²)).
 const ON_SURFACE: f32 = 0.01;
+
+#[cfg(test)]
+mod slab_tests {
+    use super::*;
+    use crate::scenes;
+
+    /// What a run of [`extract`] decided, in comparable form.
+    fn decided(run: &(EmcMesh, FanCentres, Vec<OutsideFan>)) -> impl PartialEq + std::fmt::Debug {
+        let (out, centres, outside) = run;
+        let fans: Vec<(u32, [usize; 3])> = outside.iter().map(|f| (f.vertex, f.cell)).collect();
+        let counts =
+            [out.edge_features, out.corner_features, out.approximate_features, out.rejected_features];
+        (
+            out.mesh.clone(),
+            out.feature_vertex.clone(),
+            centres.any.clone(),
+            centres.on_feature.clone(),
+            fans,
+            counts,
+        )
+    }
+
+    /// The slabs joined are one sweep over the grid, with one thread or three: on the gear's field
+    /// (features everywhere, exact crossings) and on tall noise grids (interpolated crossings).
+    #[test]
+    fn joined_slabs_are_one_sweep_vertex_for_vertex() {
+        let gear = scenes::scene("gear").unwrap();
+        let gear_grid = Grid::with_resolution(gear.min, gear.max, 72).unwrap();
+        let gear_values = crate::field::sample_grid(gear.field.as_ref(), &gear_grid).unwrap();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        let noise_grid = Grid::from_points([7, 6, 53], Vec3::splat(-1.0), Vec3::new(0.3, 0.25, 0.2)).unwrap();
+        let noise: Vec<f32> = (0..noise_grid.point_count()).map(|_| next()).collect();
+        for topology in [Topology::Fixed, Topology::Trilinear] {
+            let options = EmcOptions { topology, ..EmcOptions::default() };
+            let field_sampler =
+                FieldRoots { field: gear.field.as_ref(), iso: 0.0, directed: true, h: gear_grid.cell_size() };
+            let noise_sampler = SampleInterpolation { values: &noise, grid: &noise_grid };
+            let cases: [(&[f32], &Grid, &dyn EdgeSampler); 2] =
+                [(&gear_values, &gear_grid, &field_sampler), (&noise, &noise_grid, &noise_sampler)];
+            for (values, grid, sampler) in cases {
+                let sweep = join_slabs(vec![extract_slab(values, grid, &options, sampler, 0..grid.cells[2])]);
+                assert!(sweep.0.mesh.triangle_count() > 100);
+                for threads in [1, 3] {
+                    let joined = crate::par::with_threads(threads, || {
+                        extract(values, grid, &options, sampler).unwrap()
+                    });
+                    assert!(
+                        decided(&joined) == decided(&sweep),
+                        "{topology:?}, {threads} threads, {:?}",
+                        grid.cells
+                    );
+                }
+            }
+        }
+    }
+}

@@ -206,7 +206,7 @@ impl EdgeCache {
     }
 
     /// The x- and y-edge ids of the sweep's first and last point layers.
-    fn into_outer_layers(self) -> ([Vec<u32>; 2], [Vec<u32>; 2]) {
+    pub(crate) fn into_outer_layers(self) -> ([Vec<u32>; 2], [Vec<u32>; 2]) {
         let [lower, upper] = self.layer_edges;
         (self.first_layer.unwrap_or(lower), upper)
     }
