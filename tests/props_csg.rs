@@ -205,6 +205,31 @@ fn prop_specialised_tapes_give_the_same_meshes() {
     });
 }
 
+/// Sampling, the crust, big batches and MC's and EMC's slabs run on several threads: every
+/// method gives the same mesh and feature lines with one thread or three, at resolutions of two
+/// to four slabs.
+#[test]
+fn prop_meshes_are_the_same_on_one_thread_or_three() {
+    for_trees(9_400_000, |case| {
+        for method in [Method::Mc, Method::Emc, Method::Dmc] {
+            let request = common::bare_request(method, 2 * case.res);
+            let run = |threads| {
+                isoforge::par::with_threads(threads, || {
+                    pipeline::mesh_program(&case.program, &request).unwrap()
+                })
+            };
+            let (one, three) = (run(1), run(3));
+            assert!(
+                one.mesh == three.mesh && one.feature_edges == three.feature_edges,
+                "{method:?}: the thread count changed the mesh ({} vs {} triangles)\n{}",
+                one.mesh.triangle_count(),
+                three.mesh.triangle_count(),
+                case.describe()
+            );
+        }
+    });
+}
+
 #[test]
 fn prop_emc_keeps_mcs_topology_near_the_surface() {
     for_trees(2_500_000, |case| {
