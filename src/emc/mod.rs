@@ -589,15 +589,9 @@ mod slab_tests {
         let gear = scenes::scene("gear").unwrap();
         let gear_grid = Grid::with_resolution(gear.min, gear.max, 72).unwrap();
         let gear_values = crate::field::sample_grid(gear.field.as_ref(), &gear_grid).unwrap();
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
-        };
+        let mut rng = crate::expr::testutil::Rng::new(11);
         let noise_grid = Grid::from_points([7, 6, 53], Vec3::splat(-1.0), Vec3::new(0.3, 0.25, 0.2)).unwrap();
-        let noise: Vec<f32> = (0..noise_grid.point_count()).map(|_| next()).collect();
+        let noise: Vec<f32> = (0..noise_grid.point_count()).map(|_| rng.range(-0.5, 0.5)).collect();
         for topology in [Topology::Fixed, Topology::Trilinear] {
             let options = EmcOptions { topology, ..EmcOptions::default() };
             let field_sampler =

@@ -78,7 +78,7 @@ pub mod speed;
 mod tape;
 
 #[cfg(test)]
-mod testutil;
+pub(crate) mod testutil;
 
 pub use ast::Script;
 pub use builtins::{Arity, Builtin};

@@ -596,16 +596,9 @@ mod slab_tests {
     /// grids of several slabs, in both topologies, with one thread or several.
     #[test]
     fn joined_slabs_are_one_sweep_vertex_for_vertex() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::expr::testutil::Rng::new(7);
         for round in 0..40 {
-            let points =
-                [3 + (next() * 8.0) as usize, 3 + (next() * 8.0) as usize, 2 + (next() * 60.0) as usize];
+            let points = [3 + rng.below(8), 3 + rng.below(8), 2 + rng.below(60)];
             let grid = Grid::from_points(points, Vec3::splat(-1.0), Vec3::new(0.3, 0.25, 0.2)).unwrap();
             // Smooth blobs on odd rounds (long crossing sheets through the slab seams), noise on even.
             let values: Vec<f32> = (0..grid.point_count())
@@ -617,9 +610,9 @@ mod slab_tests {
                             .iter()
                             .map(|v| v.sin())
                             .sum::<f32>()
-                            + next() * 0.3
+                            + rng.range(0.0, 0.3)
                     } else {
-                        next() - 0.5
+                        rng.range(-0.5, 0.5)
                     }
                 })
                 .collect();
