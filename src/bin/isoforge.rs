@@ -51,8 +51,8 @@ struct MeshArgs {
     /// its bounding box padded by two cells, --res cells along the longest side.
     #[arg(long, value_name = "FILE")]
     mesh: Option<PathBuf>,
-    /// An oriented point cloud to reconstruct a surface from (.ply with nx ny nz, or .xyz text
-    /// `x y z nx ny nz`); bounds as for --mesh.
+    /// An oriented point cloud to reconstruct a surface from (.ply with nx ny nz, .xyz text
+    /// `x y z nx ny nz`, or CGAL's .pwn); bounds as for --mesh.
     #[arg(long, value_name = "FILE")]
     points: Option<PathBuf>,
     /// A raw volume: samples without a header, little-endian, x fastest (needs --dims).
