@@ -18,6 +18,7 @@ pub mod lines;
 pub mod merge;
 pub mod mesh_source;
 pub mod nearby;
+pub mod orient;
 pub mod placement;
 mod plan;
 pub mod point_source;

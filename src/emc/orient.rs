@@ -1,0 +1,334 @@
+//! Consistent normals for a point cloud: reconstruction reads the side of every grid point off the
+//! nearest sample's normal, so one normal pointing into the solid makes a bubble or a hole, and a
+//! scanner's or an estimator's output often has a few such normals (or whole patches of them).
+//!
+//! The cloud's normals are taken to be *mostly* right, and the minority that disagrees with its
+//! neighbours is turned around:
+//! 1. Every sample is joined to its [`NEIGHBOURS`] nearest, and each pair gets a vote on whether
+//!    their normals agree ([`agreement`]): +1 for surely consistent, −1 for surely one of them
+//!    flipped, near 0 for "cannot tell" (across a sharp edge, where the normals are orthogonal).
+//! 2. Pairs that clearly agree as given join into patches (union-find).
+//! 3. Patches are joined into groups, strongest summed evidence first (Kruskal's order, as in the
+//!    minimum spanning tree of Hoppe et al. 1992, but over patches, so one unlucky pair cannot
+//!    turn a large region around), each join recording whether one patch is turned relative to the
+//!    other.
+//! 4. In each group the orientation most of its samples already have wins; the others are turned.
+//! 5. A group holding one of the cloud's six extreme samples (largest and smallest x, y, z), whose
+//!    outward normal must point away from the cloud along that axis, is turned around as a whole
+//!    when those samples say it is inside out (a cloud exported with inward normals), as inside-out
+//!    triangle meshes are. Where a group of a sizeable part of the cloud is split nearly evenly and
+//!    no extreme sample settles it, its normals are not oriented at all: that is an error.
+
+use super::point_source::PointIndex;
+use crate::error::Error;
+use crate::input::PointCloud;
+use glam::Vec3;
+use std::collections::HashMap;
+
+/// Neighbours each sample is compared with.
+pub const NEIGHBOURS: usize = 10;
+
+/// A pair whose vote is at least this joins one patch: consistent beyond doubt.
+const AGREE: f32 = 0.5;
+
+/// Patches are joined only on summed evidence of at least this (a single pair's clear vote).
+const EVIDENCE: f32 = 0.5;
+
+/// A group whose minority holds more than this share of its samples is split too evenly for a
+/// majority to mean anything.
+const SPLIT: f64 = 0.4;
+
+/// Below this share of the cloud (or 20 samples), an evenly split group is left as it is rather
+/// than refused: a handful of stray samples cannot make the whole cloud unusable.
+const SIZEABLE: f64 = 0.01;
+
+/// How strongly samples `i` (at `pi`, normal `ni`) and `j` agree that their normals point to the
+/// same side of the surface, in −1..1.
+///
+/// Two tests, each reliable where the other is not:
+/// - on one smooth sheet the points lie (nearly) in each other's tangent planes, and consistent
+///   normals are (nearly) parallel: the vote is `ni·nj`;
+/// - where the points lie clearly off each other's tangent planes (across a sharp edge, where
+///   `ni·nj` can be 0, or across a thin part, where it is −1 although both point out), consistent
+///   normals put each point on the same side of the other's plane: both behind it at a convex
+///   edge or a thin wall, both in front of it at a concave edge; a flipped normal puts them on
+///   different sides. The vote is +1 or −1.
+///
+/// The offset that decides between them is the smaller of the two points' distances from the
+/// other's plane over their distance: below 0.05 (within 3° of each other's planes) the first
+/// test, above 0.2 (12°) the second, in between a blend. A sphere sampled at spacing `s` and
+/// radius `r` has offsets near `s / 2r`, so the first test holds on any surface sampled finer than
+/// a tenth of its radius of curvature.
+pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> f32 {
+    let parallel = ni.dot(nj);
+    let d = pj - pi;
+    let length = d.length();
+    if !(length > 0.0) {
+        return parallel;
+    }
+    let (ai, aj) = (ni.dot(d) / length, -nj.dot(d) / length);
+    let offset = ai.abs().min(aj.abs());
+    let w = ((offset - 0.05) / 0.15).clamp(0.0, 1.0);
+    let sides = if ai * aj > 0.0 { 1.0 } else { -1.0 };
+    (1.0 - w) * parallel + w * sides
+}
+
+/// Union-find whose elements carry a parity relative to their root: whether they are turned
+/// around with respect to it.
+struct Parity {
+    parent: Vec<u32>,
+    /// Parity relative to `parent`.
+    flip: Vec<bool>,
+    size: Vec<u32>,
+}
+
+impl Parity {
+    fn new(n: usize) -> Parity {
+        Parity { parent: (0..n as u32).collect(), flip: vec![false; n], size: vec![1; n] }
+    }
+
+    /// The root of `i` and `i`'s parity relative to it (path halving keeps the parities right by
+    /// folding them in as it shortcuts).
+    fn find(&mut self, mut i: u32) -> (u32, bool) {
+        let mut path = Vec::new();
+        while self.parent[i as usize] != i {
+            path.push(i);
+            i = self.parent[i as usize];
+        }
+        let root = i;
+        // Compress: every node on the path points at the root with its total parity.
+        let mut total = false;
+        for &node in path.iter().rev() {
+            total ^= self.flip[node as usize];
+            self.flip[node as usize] = total;
+            self.parent[node as usize] = root;
+        }
+        // Recompute from the stored parities now that each points at the root directly.
+        let first = path.first().copied();
+        match first {
+            Some(node) => (root, self.flip[node as usize]),
+            None => (root, false),
+        }
+    }
+
+    /// Joins the sets of `a` and `b` so that their parities differ by `turned`; false when they
+    /// were already one set.
+    fn union(&mut self, a: u32, b: u32, turned: bool) -> bool {
+        let ((ra, pa), (rb, pb)) = (self.find(a), self.find(b));
+        if ra == rb {
+            return false;
+        }
+        let (big, small) = if self.size[ra as usize] >= self.size[rb as usize] { (ra, rb) } else { (rb, ra) };
+        self.parent[small as usize] = big;
+        // parity(b) = parity(a) ^ turned, with parity(x) = p_x ^ parity(root_x).
+        self.flip[small as usize] = pa ^ pb ^ turned;
+        self.size[big as usize] += self.size[small as usize];
+        true
+    }
+}
+
+/// Turns around the normals of `cloud` that disagree with their neighbours (module
+/// documentation), and returns how many were turned. The cloud must pass
+/// [`PointCloud::validate`]. Fails when a sizeable part of the cloud has no prevailing
+/// orientation (its normals were estimated without one, or are random), naming how it is split.
+pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
+    let index = PointIndex::new(cloud)?;
+    let n = index.len();
+    if n < 2 {
+        return Ok(0);
+    }
+    // Pairs of (reordered) neighbours, each once, with their vote.
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(n * NEIGHBOURS);
+    let mut near = Vec::with_capacity(NEIGHBOURS + 1);
+    for i in 0..n as u32 {
+        index.k_nearest(index.sample(i).0, NEIGHBOURS + 1, &mut near);
+        pairs.extend(near.iter().filter(|&&(_, j)| j != i).map(|&(_, j)| (i.min(j), i.max(j))));
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    let votes: Vec<f32> = pairs
+        .iter()
+        .map(|&(i, j)| {
+            let ((pi, ni), (pj, nj)) = (index.sample(i), index.sample(j));
+            agreement(pi, ni, pj, nj)
+        })
+        .collect();
+
+    // Patches: samples joined by clear agreement.
+    let mut patches = Parity::new(n);
+    for (&(i, j), &v) in pairs.iter().zip(&votes) {
+        if v >= AGREE {
+            patches.union(i, j, false);
+        }
+    }
+    let patch: Vec<u32> = (0..n as u32).map(|i| patches.find(i).0).collect();
+
+    // Evidence between patches, then Kruskal over it, strongest first.
+    let mut evidence: HashMap<(u32, u32), f32> = HashMap::new();
+    for (&(i, j), &v) in pairs.iter().zip(&votes) {
+        let (a, b) = (patch[i as usize], patch[j as usize]);
+        if a != b {
+            *evidence.entry((a.min(b), a.max(b))).or_insert(0.0) += v;
+        }
+    }
+    let mut links: Vec<((u32, u32), f32)> = evidence.into_iter().filter(|e| e.1.abs() >= EVIDENCE).collect();
+    links.sort_unstable_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
+    let mut groups = Parity::new(n);
+    for ((a, b), e) in links {
+        groups.union(a, b, e < 0.0);
+    }
+
+    // Per sample: its group and whether it is turned relative to the group's root.
+    let mut group = vec![0u32; n];
+    let mut turned = vec![false; n];
+    // (samples with parity false, with parity true) per group root.
+    let mut counts: HashMap<u32, (usize, usize)> = HashMap::new();
+    for i in 0..n {
+        let (root, parity) = groups.find(patch[i]);
+        group[i] = root;
+        turned[i] = parity;
+        let c = counts.entry(root).or_insert((0, 0));
+        if parity {
+            c.1 += 1;
+        } else {
+            c.0 += 1;
+        }
+    }
+    // The parity a group's samples should end with: the majority's.
+    let mut keep: HashMap<u32, bool> = counts.iter().map(|(&g, &(even, odd))| (g, odd > even)).collect();
+
+    // The six extreme samples vote on each group they belong to, with the majority applied.
+    let mut extremes = [(f32::NEG_INFINITY, 0u32); 6];
+    let directions = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    for i in 0..n as u32 {
+        let p = index.sample(i).0;
+        for (e, d) in extremes.iter_mut().zip(directions) {
+            if p.dot(d) > e.0 {
+                *e = (p.dot(d), i);
+            }
+        }
+    }
+    let mut outward: HashMap<u32, f32> = HashMap::new();
+    for ((_, i), d) in extremes.iter().zip(directions) {
+        let i = *i as usize;
+        let normal = index.sample(i as u32).1;
+        let as_kept = if turned[i] == keep[&group[i]] { normal } else { -normal };
+        let along = as_kept.dot(d);
+        if along.abs() > 0.3 {
+            *outward.entry(group[i]).or_insert(0.0) += along.signum();
+        }
+    }
+    for (g, vote) in &outward {
+        if *vote < 0.0 {
+            let k = keep.get_mut(g).expect("every group has a count");
+            *k = !*k;
+        }
+    }
+    for (g, &(even, odd)) in &counts {
+        let (size, minority) = (even + odd, even.min(odd));
+        let settled = outward.get(g).is_some_and(|v| *v != 0.0);
+        if !settled && size >= 20 && size as f64 >= SIZEABLE * n as f64 && minority as f64 > SPLIT * size as f64 {
+            return Err(Error::InvalidOption(format!(
+                "the normals of a connected part of {size} of the {n} points are not oriented: {even} \
+                 point one way and {odd} the other, and nothing tells which side is out; give \
+                 normals that point out of the solid (most of them at least)"
+            )));
+        }
+    }
+
+    let mut changed = 0;
+    for i in 0..n {
+        if turned[i] != keep[&group[i]] {
+            let original = index.original(i as u32);
+            cloud.normals[original] = -cloud.normals[original];
+            changed += 1;
+        }
+    }
+    Ok(changed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn votes_read_sharp_edges_and_thin_walls() {
+        // One smooth sheet: parallel normals agree, opposite ones do not.
+        let (a, b) = (Vec3::ZERO, Vec3::new(0.1, 0.0, 0.0));
+        assert!(agreement(a, Vec3::Z, b, Vec3::Z) > 0.99);
+        assert!(agreement(a, Vec3::Z, b, -Vec3::Z) < -0.99);
+        // A convex 90° edge: orthogonal normals, each point behind the other's plane.
+        let (top, side) = (Vec3::new(-0.05, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.05));
+        assert!(agreement(top, Vec3::Z, side, Vec3::X) > 0.99);
+        assert!(agreement(top, Vec3::Z, side, -Vec3::X) < -0.99);
+        // A concave one: each in front of the other's plane.
+        assert!(agreement(top, -Vec3::Z, side, -Vec3::X) > 0.99);
+        // The two faces of a thin wall: opposite normals that agree.
+        let (up, down) = (Vec3::new(0.0, 0.0, 0.01), Vec3::new(0.03, 0.0, -0.01));
+        assert!(agreement(up, Vec3::Z, down, -Vec3::Z) > 0.99);
+        assert!(agreement(up, Vec3::Z, down, Vec3::Z) < -0.99);
+        // Coincident samples: the normals alone.
+        assert_eq!(agreement(a, Vec3::Z, a, Vec3::X), 0.0);
+    }
+
+    #[test]
+    fn parity_union_find_composes_turns() {
+        let mut p = Parity::new(5);
+        assert!(p.union(0, 1, true));
+        assert!(p.union(2, 3, true));
+        assert!(p.union(1, 3, false));
+        assert!(!p.union(0, 3, true));
+        let parity = |p: &mut Parity, i| p.find(i).1;
+        let root = p.find(0).0;
+        assert!((0..4).all(|i| p.find(i).0 == root));
+        assert_ne!(parity(&mut p, 0), parity(&mut p, 1));
+        assert_eq!(parity(&mut p, 1), parity(&mut p, 3));
+        assert_ne!(parity(&mut p, 2), parity(&mut p, 3));
+        assert_eq!(p.find(4), (4, false));
+    }
+
+    /// `n` points on the unit sphere (a Fibonacci lattice), normals outward.
+    fn sphere(n: usize) -> PointCloud {
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let mut cloud = PointCloud::default();
+        for i in 0..n {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let rho = (1.0 - z * z).sqrt();
+            let p = Vec3::new(rho * (golden * i as f32).cos(), rho * (golden * i as f32).sin(), z);
+            cloud.positions.push(p);
+            cloud.normals.push(p);
+        }
+        cloud
+    }
+
+    #[test]
+    fn stray_and_inward_normals_are_turned_out() {
+        let truth = sphere(2000);
+        let mut cloud = truth.clone();
+        for i in (0..2000).step_by(37) {
+            cloud.normals[i] = -cloud.normals[i];
+        }
+        assert_eq!(orient_normals(&mut cloud).unwrap(), 55);
+        assert_eq!(cloud, truth);
+        assert_eq!(orient_normals(&mut cloud).unwrap(), 0, "a consistent cloud is left alone");
+        // Every normal inward: the extremes turn it all around.
+        let mut inward = truth.clone();
+        inward.normals.iter_mut().for_each(|n| *n = -*n);
+        assert_eq!(orient_normals(&mut inward).unwrap(), 2000);
+        assert_eq!(inward, truth);
+    }
+
+    #[test]
+    fn unoriented_normals_are_an_error_where_nothing_settles_them() {
+        // Two spheres nested: the inner one's extremes are not the cloud's, and its normals are
+        // split evenly.
+        let mut cloud = sphere(1500);
+        let inner = sphere(1000);
+        for (k, (p, n)) in inner.positions.iter().zip(&inner.normals).enumerate() {
+            cloud.positions.push(*p * 0.5);
+            cloud.normals.push(if k % 2 == 0 { -*n } else { *n });
+        }
+        let err = orient_normals(&mut cloud).unwrap_err().to_string();
+        assert!(err.contains("not oriented") && err.contains("of the 2500 points"), "{err}");
+    }
+}
