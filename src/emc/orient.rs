@@ -7,13 +7,17 @@
 //! 1. Every sample is joined to its [`NEIGHBOURS`] nearest, and each pair gets a vote on whether
 //!    their normals agree ([`agreement`]): +1 for surely consistent, −1 for surely one of them
 //!    flipped, near 0 for "cannot tell" (across a sharp edge, where the normals are orthogonal).
-//! 2. Pairs that clearly agree as given join into patches (union-find).
+//! 2. Pairs on one smooth sheet whose normals clearly agree as given join into patches
+//!    (union-find).
 //! 3. Patches are joined into groups, strongest summed evidence first (Kruskal's order, as in the
 //!    minimum spanning tree of Hoppe et al. 1992, but over patches, so one unlucky pair cannot
 //!    turn a large region around), each join recording whether one patch is turned relative to the
 //!    other.
 //! 4. In each group the orientation most of its samples already have wins; the others are turned.
-//! 5. A group holding one of the cloud's six extreme samples (largest and smallest x, y, z), whose
+//! 5. Each patch is turned only where most of the evidence on its own links agrees with that
+//!    (a sample alone on a sliver of a face at a corner has only votes across sharp edges, which
+//!    can contradict each other; it keeps the normal it came with).
+//! 6. A group holding one of the cloud's six extreme samples (largest and smallest x, y, z), whose
 //!    outward normal must point away from the cloud along that axis, is turned around as a whole
 //!    when those samples say it is inside out (a cloud exported with inward normals), as inside-out
 //!    triangle meshes are. Where a group of a sizeable part of the cloud is split nearly evenly and
@@ -43,15 +47,15 @@ const SPLIT: f64 = 0.4;
 const SIZEABLE: f64 = 0.01;
 
 /// How strongly samples `i` (at `pi`, normal `ni`) and `j` agree that their normals point to the
-/// same side of the surface, in −1..1.
+/// same side of the surface, in −1..1, and whether that rests on the normals alone (the two lie
+/// on one smooth sheet).
 ///
 /// Two tests, each reliable where the other is not:
 /// - on one smooth sheet the points lie (nearly) in each other's tangent planes, and consistent
 ///   normals are (nearly) parallel: the vote is `ni·nj`;
-/// - where the points lie clearly off each other's tangent planes (across a sharp edge, where
-///   `ni·nj` can be 0, or across a thin part, where it is −1 although both point out), consistent
-///   normals put each point on the same side of the other's plane: both behind it at a convex
-///   edge or a thin wall, both in front of it at a concave edge; a flipped normal puts them on
+/// - across a sharp edge the points lie clearly off each other's tangent planes and `ni·nj` can be
+///   0; consistent normals then put each point on the same side of the other's plane: both behind
+///   it at a convex edge, both in front of it at a concave one, while a flipped normal puts them on
 ///   different sides. The vote is +1 or −1.
 ///
 /// The offset that decides between them is the smaller of the two points' distances from the
@@ -59,18 +63,29 @@ const SIZEABLE: f64 = 0.01;
 /// test, above 0.2 (12°) the second, in between a blend. A sphere sampled at spacing `s` and
 /// radius `r` has offsets near `s / 2r`, so the first test holds on any surface sampled finer than
 /// a tenth of its radius of curvature.
-pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> f32 {
+///
+/// Where the normals are (anti)parallel (`|ni·nj| ≥ 0.5`) but the points lie off each other's
+/// planes, the two tests can contradict each other and neither is reliable: a step (a convex edge
+/// and a concave one) with consistent normals reads as flipped to the second test, the two faces
+/// of a wall thinner than the neighbourhood read as flipped to the first. Such a pair has no vote.
+pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> (f32, bool) {
     let parallel = ni.dot(nj);
     let d = pj - pi;
     let length = d.length();
     if !(length > 0.0) {
-        return parallel;
+        return (parallel, true);
     }
     let (ai, aj) = (ni.dot(d) / length, -nj.dot(d) / length);
     let offset = ai.abs().min(aj.abs());
     let w = ((offset - 0.05) / 0.15).clamp(0.0, 1.0);
+    if w == 0.0 {
+        return (parallel, true);
+    }
     let sides = if ai * aj > 0.0 { 1.0 } else { -1.0 };
-    (1.0 - w) * parallel + w * sides
+    if parallel.abs() >= 0.5 && parallel * sides < 0.0 {
+        return (0.0, false);
+    }
+    ((1.0 - w) * parallel + w * sides, false)
 }
 
 /// Union-find whose elements carry a parity relative to their root: whether they are turned
@@ -146,18 +161,19 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
     }
     pairs.sort_unstable();
     pairs.dedup();
-    let votes: Vec<f32> = pairs
+    let (votes, smooth): (Vec<f32>, Vec<bool>) = pairs
         .iter()
         .map(|&(i, j)| {
             let ((pi, ni), (pj, nj)) = (index.sample(i), index.sample(j));
             agreement(pi, ni, pj, nj)
         })
-        .collect();
+        .unzip();
 
-    // Patches: samples joined by clear agreement.
+    // Patches: samples joined by clear agreement of their normals on one smooth sheet. Votes
+    // across sharp edges only count summed up, between patches.
     let mut patches = Parity::new(n);
-    for (&(i, j), &v) in pairs.iter().zip(&votes) {
-        if v >= AGREE {
+    for ((&(i, j), &v), &smooth) in pairs.iter().zip(&votes).zip(&smooth) {
+        if smooth && v >= AGREE {
             patches.union(i, j, false);
         }
     }
@@ -171,10 +187,10 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
             *evidence.entry((a.min(b), a.max(b))).or_insert(0.0) += v;
         }
     }
-    let mut links: Vec<((u32, u32), f32)> = evidence.into_iter().filter(|e| e.1.abs() >= EVIDENCE).collect();
+    let mut links: Vec<((u32, u32), f32)> = evidence.into_iter().collect();
     links.sort_unstable_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
     let mut groups = Parity::new(n);
-    for ((a, b), e) in links {
+    for &((a, b), e) in links.iter().take_while(|l| l.1.abs() >= EVIDENCE) {
         groups.union(a, b, e < 0.0);
     }
 
@@ -236,9 +252,33 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
         }
     }
 
+    // The proposal per patch (all its samples share it), checked against the patch's own links:
+    // a patch is turned only if at least 3/4 of the evidence on its links, with its neighbours as
+    // proposed, says so. A sample alone on a sliver of a face next to a corner has only votes
+    // across sharp edges, some of them across two edges at once, which read a consistent pair as
+    // flipped; where those contradict each other, the normal it came with stands.
+    let mut turn: HashMap<u32, bool> = HashMap::new();
+    for i in 0..n {
+        turn.insert(patch[i], turned[i] != keep[&group[i]]);
+    }
+    // (evidence for turning, total evidence) per patch
+    let mut support: HashMap<u32, (f32, f32)> = HashMap::new();
+    for &((a, b), e) in &links {
+        for (p, q) in [(a, b), (b, a)] {
+            let other = if turn[&q] { -1.0 } else { 1.0 };
+            let s = support.entry(p).or_insert((0.0, 0.0));
+            s.0 -= e * other;
+            s.1 += e.abs();
+        }
+    }
+    for (p, t) in turn.iter_mut() {
+        if let Some(&(for_turning, total)) = support.get(p) {
+            *t = *t && for_turning >= 0.5 * total;
+        }
+    }
     let mut changed = 0;
     for i in 0..n {
-        if turned[i] != keep[&group[i]] {
+        if turn[&patch[i]] {
             let original = index.original(i as u32);
             cloud.normals[original] = -cloud.normals[original];
             changed += 1;
@@ -252,23 +292,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn votes_read_sharp_edges_and_thin_walls() {
+    fn votes_read_sharp_edges_and_abstain_where_unsure() {
+        let vote = |pi, ni, pj, nj| agreement(pi, ni, pj, nj).0;
         // One smooth sheet: parallel normals agree, opposite ones do not.
         let (a, b) = (Vec3::ZERO, Vec3::new(0.1, 0.0, 0.0));
-        assert!(agreement(a, Vec3::Z, b, Vec3::Z) > 0.99);
-        assert!(agreement(a, Vec3::Z, b, -Vec3::Z) < -0.99);
+        assert_eq!(agreement(a, Vec3::Z, b, Vec3::Z), (1.0, true));
+        assert_eq!(agreement(a, Vec3::Z, b, -Vec3::Z), (-1.0, true));
         // A convex 90° edge: orthogonal normals, each point behind the other's plane.
         let (top, side) = (Vec3::new(-0.05, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.05));
-        assert!(agreement(top, Vec3::Z, side, Vec3::X) > 0.99);
-        assert!(agreement(top, Vec3::Z, side, -Vec3::X) < -0.99);
+        assert_eq!(agreement(top, Vec3::Z, side, Vec3::X), (1.0, false));
+        assert!(vote(top, Vec3::Z, side, -Vec3::X) < -0.99);
         // A concave one: each in front of the other's plane.
-        assert!(agreement(top, -Vec3::Z, side, -Vec3::X) > 0.99);
-        // The two faces of a thin wall: opposite normals that agree.
+        assert!(vote(top, -Vec3::Z, side, -Vec3::X) > 0.99);
+        // The two faces of a thin wall, or a step: opposite or parallel normals off each other's
+        // planes. Either reading could be the flipped one, so no vote.
         let (up, down) = (Vec3::new(0.0, 0.0, 0.01), Vec3::new(0.03, 0.0, -0.01));
-        assert!(agreement(up, Vec3::Z, down, -Vec3::Z) > 0.99);
-        assert!(agreement(up, Vec3::Z, down, Vec3::Z) < -0.99);
+        assert_eq!(vote(up, Vec3::Z, down, -Vec3::Z), 0.0);
+        assert_eq!(vote(up, Vec3::Z, down, Vec3::Z), 0.0);
         // Coincident samples: the normals alone.
-        assert_eq!(agreement(a, Vec3::Z, a, Vec3::X), 0.0);
+        assert_eq!(agreement(a, Vec3::Z, a, Vec3::X), (0.0, true));
     }
 
     #[test]
