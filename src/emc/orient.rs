@@ -20,8 +20,11 @@
 //! 6. A group holding one of the cloud's six extreme samples (largest and smallest x, y, z), whose
 //!    outward normal must point away from the cloud along that axis, is turned around as a whole
 //!    when those samples say it is inside out (a cloud exported with inward normals), as inside-out
-//!    triangle meshes are. Where a group of a sizeable part of the cloud is split nearly evenly and
-//!    no extreme sample settles it, its normals are not oriented at all: that is an error.
+//!    triangle meshes are.
+//! 7. A group split nearly evenly that no extreme sample settles is an error where most of its
+//!    neighbouring normals disagree (the cloud has no orientation to restore), and otherwise keeps
+//!    its normals but for patches their own neighbours clearly overrule (the relations between
+//!    patches went wrong, as they can across parts thinner than the samples' neighbourhoods).
 
 use super::point_source::PointIndex;
 use crate::error::Error;
@@ -41,6 +44,10 @@ const EVIDENCE: f32 = 0.5;
 /// A group whose minority holds more than this share of its samples is split too evenly for a
 /// majority to mean anything.
 const SPLIT: f64 = 0.4;
+
+/// A group whose pairs' votes say "flipped" with more than this share of their weight has no
+/// orientation to restore.
+const DISORDER: f64 = 0.3;
 
 /// Below this share of the cloud (or 20 samples), an evenly split group is left as it is rather
 /// than refused: a handful of stray samples cannot make the whole cloud unusable.
@@ -240,26 +247,49 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
             *k = !*k;
         }
     }
+    // How much of the pairs' vote weight within each group says "flipped" as the normals are given:
+    // a few per cent for a cloud with stray normals (each has ~10 neighbours voting against it),
+    // near half for one without an orientation.
+    let mut against: HashMap<u32, (f64, f64)> = HashMap::new();
+    for (&(i, _), &v) in pairs.iter().zip(&votes) {
+        let a = against.entry(group[i as usize]).or_insert((0.0, 0.0));
+        a.0 += (-v).max(0.0) as f64;
+        a.1 += v.abs() as f64;
+    }
+    // Groups the majority cannot settle: split nearly evenly, with no extreme sample. Either the
+    // normals have no orientation (most pairs disagree: an error), or they have one and the
+    // relations between patches went wrong somewhere (across parts thinner than the samples'
+    // neighbourhoods): then only patches their own neighbours overrule are turned (below).
+    let mut unsettled = std::collections::HashSet::new();
     for (g, &(even, odd)) in &counts {
         let (size, minority) = (even + odd, even.min(odd));
         let settled = outward.get(g).is_some_and(|v| *v != 0.0);
-        if !settled && size >= 20 && size as f64 >= SIZEABLE * n as f64 && minority as f64 > SPLIT * size as f64 {
+        if settled || minority as f64 <= SPLIT * size as f64 {
+            continue;
+        }
+        let (bad, total) = against.get(g).copied().unwrap_or((0.0, 0.0));
+        if size >= 20 && size as f64 >= SIZEABLE * n as f64 && bad > DISORDER * total {
             return Err(Error::InvalidOption(format!(
-                "the normals of a connected part of {size} of the {n} points are not oriented: {even} \
-                 point one way and {odd} the other, and nothing tells which side is out; give \
-                 normals that point out of the solid (most of them at least)"
+                "the normals of a connected part of {size} of the {n} points are not oriented: \
+                 {:.0} % of neighbouring normals disagree, {even} point one way and {odd} the \
+                 other, and nothing tells which side is out; give normals that point out of the \
+                 solid (most of them at least)",
+                100.0 * bad / total.max(f64::MIN_POSITIVE)
             )));
         }
+        unsettled.insert(*g);
     }
 
     // The proposal per patch (all its samples share it), checked against the patch's own links:
     // a patch is turned only if at least 3/4 of the evidence on its links, with its neighbours as
     // proposed, says so. A sample alone on a sliver of a face next to a corner has only votes
     // across sharp edges, some of them across two edges at once, which read a consistent pair as
-    // flipped; where those contradict each other, the normal it came with stands.
+    // flipped; where those contradict each other, the normal it came with stands. In an unsettled
+    // group the proposal is the normals as given, and only patches their links overrule turn.
     let mut turn: HashMap<u32, bool> = HashMap::new();
     for i in 0..n {
-        turn.insert(patch[i], turned[i] != keep[&group[i]]);
+        let proposed = turned[i] != keep[&group[i]];
+        turn.insert(patch[i], proposed && !unsettled.contains(&group[i]));
     }
     // (evidence for turning, total evidence) per patch
     let mut support: HashMap<u32, (f32, f32)> = HashMap::new();
@@ -273,7 +303,8 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
     }
     for (p, t) in turn.iter_mut() {
         if let Some(&(for_turning, total)) = support.get(p) {
-            *t = *t && for_turning >= 0.5 * total;
+            let overruled = for_turning >= 0.5 * total && total >= EVIDENCE;
+            *t = if unsettled.contains(&groups.find(*p).0) { overruled } else { *t && for_turning >= 0.5 * total };
         }
     }
     let mut changed = 0;
