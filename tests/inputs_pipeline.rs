@@ -159,6 +159,81 @@ fn a_sampled_sphere_reconstructs_closed_near_the_sphere() {
     }
 }
 
+/// The ball.ply: 31 374 samples of a ball with 92 normals pointing in, scattered (60) and
+/// in a patch (32). Unoriented, that reconstructs into a sphere full of bubbles and holes; the
+/// pipeline turns the 92 back first and meshes the sphere.
+#[test]
+fn a_ball_with_92_flipped_normals_reconstructs_as_the_ball() {
+    let c = Vec3::new(0.03, -0.02, 0.01);
+    let truth = sphere_cloud(31374, 0.7, c);
+    let mut cloud = truth.clone();
+    let mut rng = Rng::new(92);
+    let mut flipped = std::collections::BTreeSet::new();
+    while flipped.len() < 60 {
+        flipped.insert(rng.below(31374) as usize);
+    }
+    // A patch: the 32 samples nearest to one of them (a Fibonacci lattice's neighbours in index
+    // are not its neighbours on the sphere, so by distance).
+    let centre = truth.positions[12345];
+    let mut by_distance: Vec<usize> = (0..truth.len()).filter(|i| !flipped.contains(i)).collect();
+    by_distance.sort_by(|&a, &b| {
+        (truth.positions[a] - centre).length().total_cmp(&(truth.positions[b] - centre).length())
+    });
+    flipped.extend(by_distance.into_iter().take(32));
+    for &i in &flipped {
+        cloud.normals[i] = -cloud.normals[i];
+    }
+    assert_eq!(flipped.len(), 92);
+
+    // What orientation undoes: EMC straight on the damaged normals.
+    let grid =
+        isoforge::emc::mesh_source::padded_grid(c - Vec3::splat(0.7), c + Vec3::splat(0.7), 32).unwrap();
+    let (raw, _) =
+        isoforge::emc::point_source::reconstruct(&cloud, &grid, &isoforge::emc::EmcOptions::default())
+            .unwrap();
+    let raw_topo = isoforge::mesh::analysis::topology(&raw.mesh);
+    eprintln!(
+        "ball, 92 of 31374 normals flipped, unoriented: {} components, {} boundary edges, euler {}",
+        raw_topo.components, raw_topo.boundary_edges, raw_topo.euler
+    );
+    assert_ne!((raw_topo.components, raw_topo.euler), (1, 2), "the damage must matter for this test to");
+
+    let mut oriented = cloud.clone();
+    assert_eq!(isoforge::emc::orient::orient_normals(&mut oriented).unwrap(), 92);
+    assert_eq!(oriented, truth);
+    for method in [Method::Emc, Method::Mc] {
+        let out = pipeline::mesh_points(&cloud, &request(method, 32)).unwrap();
+        let what = format!("ball with 92 flipped normals, {}", method.name());
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        let h = 1.4 / 28.0;
+        let off = out.mesh.positions.iter().map(|&p| ((p - c).length() - 0.7).abs()).fold(0.0, f32::max) / h;
+        assert!(off < 0.05, "{what}: a vertex is {off} cells off the sphere");
+    }
+}
+
+/// Clouds whose normals cannot be made consistent are refused; a cloud exported inside out is
+/// turned around, like an inside-out mesh.
+#[test]
+fn unoriented_clouds_are_refused_and_inside_out_ones_turned() {
+    let mut rng = Rng::new(5);
+    let mut random = sphere_cloud(4000, 0.7, Vec3::ZERO);
+    // An inner sphere with random signs: its extremes are not the cloud's.
+    for (p, n) in
+        sphere_cloud(3000, 0.3, Vec3::ZERO).positions.iter().zip(sphere_cloud(3000, 0.3, Vec3::ZERO).normals)
+    {
+        random.positions.push(*p);
+        random.normals.push(if rng.below(2) == 0 { n } else { -n });
+    }
+    let err = pipeline::mesh_points(&random, &request(Method::Emc, 24)).unwrap_err().to_string();
+    assert!(err.contains("not oriented") && err.contains("of the 7000 points"), "{err}");
+    let mut inward = sphere_cloud(4000, 0.7, Vec3::ZERO);
+    inward.normals.iter_mut().for_each(|n| *n = -*n);
+    let out = pipeline::mesh_points(&inward, &request(Method::Emc, 24)).unwrap();
+    let topo = assert_watertight(&out.mesh, "inside-out sphere cloud");
+    assert_eq!((topo.euler, topo.components), (2, 1));
+}
+
 #[test]
 fn a_sampled_box_reconstructs_with_its_corners() {
     let mut rng = Rng::new(11);

@@ -260,7 +260,8 @@ impl Part {
                     pick -= area;
                 }
                 let side = if rng.below(2) == 0 { 1.0 } else { -1.0 };
-                let mut local = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
+                let mut local =
+                    Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
                 local[axis] = side * half[axis];
                 let mut n = Vec3::ZERO;
                 n[axis] = side;
@@ -371,7 +372,10 @@ fn prop_flipped_normals_are_turned_back() {
             assert_eq!((topo.components, topo.euler), (components, 2 * components as i64), "{what}");
         }
         if wrong == 0 {
-            assert_eq!(out.mesh.positions, clean.mesh.positions, "{what}: differs from the undamaged cloud's");
+            assert_eq!(
+                out.mesh.positions, clean.mesh.positions,
+                "{what}: differs from the undamaged cloud's"
+            );
         }
     }
 }

@@ -304,7 +304,11 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
     for (p, t) in turn.iter_mut() {
         if let Some(&(for_turning, total)) = support.get(p) {
             let overruled = for_turning >= 0.5 * total && total >= EVIDENCE;
-            *t = if unsettled.contains(&groups.find(*p).0) { overruled } else { *t && for_turning >= 0.5 * total };
+            *t = if unsettled.contains(&groups.find(*p).0) {
+                overruled
+            } else {
+                *t && for_turning >= 0.5 * total
+            };
         }
     }
     let mut changed = 0;
