@@ -126,6 +126,39 @@ fn assert_open_only_on_the_grid(out: &Output, grid: &Grid, what: &str) -> analys
     topo
 }
 
+/// A closed mesh with 1–5 random triangles removed (punched holes): refused with the number of
+/// open edges, by every method, never meshed into something of another genus. The count is the
+/// number of edges of the removed triangles that the rest of the mesh still uses once (an edge
+/// two removed triangles share is gone entirely).
+#[test]
+fn prop_meshes_with_holes_are_refused() {
+    for seed in case_seeds(8_500_000, CI_CASES) {
+        let mut rng = Rng::new(seed);
+        let (source, text) = source_mesh(&mut rng, 12);
+        let mut holed = source.clone();
+        let mut removed = Vec::new();
+        for _ in 0..1 + rng.below(5) {
+            removed.push(holed.triangles.swap_remove(rng.below(holed.triangles.len() as u64) as usize));
+        }
+        let mut edges = std::collections::HashMap::new();
+        for t in &removed {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let open = edges.values().filter(|&&n| n == 1).count();
+        let what = format!("seed {seed}, {} triangles removed from the mesh of {text}", removed.len());
+        for method in [Method::Mc, Method::Emc, Method::Dmc] {
+            let err = pipeline::mesh_triangles(&holed, &bare_request(method, 16))
+                .err()
+                .unwrap_or_else(|| panic!("{what}: {} meshed it", method.name()))
+                .to_string();
+            assert!(err.contains(&format!("has {open} open edges (holes or a border)")), "{what}: {err}");
+        }
+    }
+}
+
 /// Closed inputs and damaged ones alike: MC and EMC accept them and mesh a closed, outward
 /// manifold; EMC has MC's Euler characteristic and components on the same grid; a duplicated or
 /// zero-area triangle changes nothing but the input's face count; an inside-out mesh meshes like

@@ -1,5 +1,6 @@
 //! Directed distances from a closed triangle mesh (paper §3.1, "Polygonal meshes"): EMC as a
-//! remesher (§5.3). Every edge crossing is where an axis-aligned ray from the grid point first
+//! remesher (§5.3). An open mesh (one with holes or a border: [`open_edges`]) is refused, since
+//! the side of a point is not defined for it and the votes below would make one up. Every edge crossing is where an axis-aligned ray from the grid point first
 //! meets a triangle, and its normal is that triangle's, so sharp edges and corners of the input
 //! come back as feature lines and corners of the output.
 //!
@@ -29,6 +30,7 @@ use crate::mc::ms_since;
 use crate::mesh::analysis::bvh::{Aabb, Bvh};
 use crate::mesh::Mesh;
 use glam::{DVec2, Vec3};
+use std::collections::HashMap;
 use web_time::Instant;
 
 /// A triangle's corners as bits, turned so the smallest comes first: the same key for the same
@@ -94,6 +96,15 @@ impl MeshBvh {
             return Err(Error::InvalidOption(format!(
                 "the mesh has no triangles with area ({} degenerate ones) and encloses nothing",
                 degenerate
+            )));
+        }
+        let open = open_edges(mesh);
+        if let Some(&(a, b)) = open.first() {
+            return Err(Error::InvalidOption(format!(
+                "the mesh has {} open edges (holes or a border), e.g. from {a} to {b}; an open \
+                 surface has no inside, so the side of a grid point is not defined and remeshing \
+                 it would invent one: close the holes first",
+                open.len()
             )));
         }
         let flipped = volume < 0.0;
@@ -225,6 +236,42 @@ impl MeshBvh {
         }
         votes
     }
+}
+
+/// The open edges of a triangle mesh, as pairs of corner positions: edges used by an odd number of
+/// its triangles (repeats of a triangle, the same [`cyclic_key`], counted once). Corners are
+/// matched by their coordinates, so a mesh whose faces do not share vertices (as in STL, or an
+/// exporter that splits vertices at seams) counts as closed where it is.
+///
+/// Around a closed surface (any number of shells, overlapping or not, non-manifold edges
+/// included) every edge has an even number of triangles, and a line crossing it changes its
+/// winding number only where it crosses the surface; at an edge of a hole the winding number
+/// jumps in mid-air, so inside and outside are not defined. Triangles without area stay in the
+/// count (a zero-area sliver in a closed mesh closes it as much as any other triangle; one
+/// repeating a corner uses its edge twice). Faces wound against their neighbours leave edges used
+/// twice the same way: those are not open, and the votes of the three axes (module documentation)
+/// decide around them as before.
+fn open_edges(mesh: &Mesh) -> Vec<(Vec3, Vec3)> {
+    let key = |p: Vec3| (p + Vec3::ZERO).to_array().map(f32::to_bits);
+    let mut uses: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::with_capacity(mesh.triangles.len() * 2);
+    let mut counted = std::collections::HashSet::with_capacity(mesh.triangles.len());
+    for t in 0..mesh.triangles.len() {
+        let corners = mesh.corners(t);
+        let area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length_squared() > 0.0;
+        if area && !counted.insert(cyclic_key(corners)) {
+            continue;
+        }
+        for k in 0..3 {
+            let (a, b) = (key(corners[k]), key(corners[(k + 1) % 3]));
+            if a != b {
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+    }
+    let mut open: Vec<([u32; 3], [u32; 3])> = uses.into_iter().filter(|e| e.1 % 2 == 1).map(|e| e.0).collect();
+    open.sort_unstable();
+    let position = |bits: [u32; 3]| Vec3::from(bits.map(f32::from_bits));
+    open.into_iter().map(|(a, b)| (position(a), position(b))).collect()
 }
 
 /// The axis `d` runs along, when its other two components are exactly zero.
@@ -542,6 +589,39 @@ mod tests {
             3,
             "the centre, on lines through the vertices"
         );
+    }
+
+    #[test]
+    fn open_meshes_are_refused_and_closed_ones_counted_by_position() {
+        let m = cube();
+        // Every face's vertices split apart (as an STL would have them): still closed.
+        let mut split = Mesh::default();
+        for t in 0..m.triangles.len() {
+            let base = split.positions.len() as u32;
+            split.positions.extend(m.corners(t));
+            split.triangles.push([base, base + 1, base + 2]);
+        }
+        assert!(open_edges(&split).is_empty());
+        // A zero-area triangle repeating a corner and a repeated triangle change nothing.
+        let mut extra = m.clone();
+        extra.triangles.push([0, 0, 1]);
+        extra.triangles.push(m.triangles[3]);
+        assert!(open_edges(&extra).is_empty());
+        // One triangle missing: its three edges are open.
+        let mut holed = m.clone();
+        holed.triangles.remove(5);
+        assert_eq!(open_edges(&holed).len(), 3);
+        let err = MeshBvh::new(&holed).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(err.contains("3 open edges (holes or a border)"), "{err}");
+        // A face wound the wrong way round is not a hole.
+        let mut misturned = m.clone();
+        misturned.triangles[5].swap(1, 2);
+        assert!(open_edges(&misturned).is_empty());
+        // A triangle [0, 0, 1] uses its edge twice; alone it would be open once the cube's face
+        // next to it is gone.
+        let mut sliver = holed.clone();
+        sliver.triangles.push([0, 0, 1]);
+        assert_eq!(open_edges(&sliver).len(), 3);
     }
 
     #[test]
