@@ -268,7 +268,8 @@ fn open_edges(mesh: &Mesh) -> Vec<(Vec3, Vec3)> {
             }
         }
     }
-    let mut open: Vec<([u32; 3], [u32; 3])> = uses.into_iter().filter(|e| e.1 % 2 == 1).map(|e| e.0).collect();
+    let mut open: Vec<([u32; 3], [u32; 3])> =
+        uses.into_iter().filter(|e| e.1 % 2 == 1).map(|e| e.0).collect();
     open.sort_unstable();
     let position = |bits: [u32; 3]| Vec3::from(bits.map(f32::from_bits));
     open.into_iter().map(|(a, b)| (position(a), position(b))).collect()

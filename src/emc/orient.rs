@@ -79,7 +79,7 @@ pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> (f32, bool) {
     let parallel = ni.dot(nj);
     let d = pj - pi;
     let length = d.length();
-    if !(length > 0.0) {
+    if length <= 0.0 || length.is_nan() {
         return (parallel, true);
     }
     let (ai, aj) = (ni.dot(d) / length, -nj.dot(d) / length);
