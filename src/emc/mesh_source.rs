@@ -1,6 +1,8 @@
 //! Directed distances from a closed triangle mesh (paper §3.1, "Polygonal meshes"): EMC as a
-//! remesher (§5.3). An open mesh (one with holes or a border: [`open_edges`]) is refused, since
-//! the side of a point is not defined for it and the votes below would make one up. Every edge crossing is where an axis-aligned ray from the grid point first
+//! remesher (§5.3). For a mesh with holes or a border ([`open_edges`]) the votes below are not
+//! defined (a line through a hole counts one crossing too few from there on) and inside is where
+//! the generalised winding number ([`super::winding`]) is at least 1/2 instead: the holes are
+//! closed by a surface spanning their rims. Every edge crossing is where an axis-aligned ray from the grid point first
 //! meets a triangle, and its normal is that triangle's, so sharp edges and corners of the input
 //! come back as feature lines and corners of the output.
 //!
@@ -23,6 +25,7 @@
 //! So a ray through an edge or vertex of a closed mesh counts one crossing, never zero or two.
 
 use super::edges::EdgeSampler;
+use super::winding::WindingTree;
 use super::{mesh_with_sampler, EmcMesh, EmcOptions, EmcTimings};
 use crate::error::Error;
 use crate::grid::Grid;
@@ -57,6 +60,10 @@ pub struct MeshBvh {
     pub duplicates: usize,
     /// Whether the input was inside out (negative enclosed volume) and was turned around.
     pub flipped: bool,
+    /// Edges of the input used by an odd number of triangles ([`open_edges`]): the edges of its
+    /// holes or border. Where there are any, inside is decided by the generalised winding number.
+    pub open_edges: usize,
+    winding: Option<WindingTree>,
 }
 
 impl MeshBvh {
@@ -90,7 +97,17 @@ impl MeshBvh {
                 continue;
             }
             triangles.push([a, b, c]);
-            volume += a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3()));
+        }
+        // Six times the enclosed volume, about the middle of the box so that it means something
+        // for an open mesh too (a closed one's is the same about any point).
+        let (lo, hi) = triangles
+            .iter()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let middle = ((lo + hi) * 0.5).as_dvec3();
+        for [a, b, c] in &triangles {
+            let (a, b, c) = (a.as_dvec3() - middle, b.as_dvec3() - middle, c.as_dvec3() - middle);
+            volume += a.dot(b.cross(c));
         }
         if triangles.is_empty() {
             return Err(Error::InvalidOption(format!(
@@ -98,15 +115,7 @@ impl MeshBvh {
                 degenerate
             )));
         }
-        let open = open_edges(mesh);
-        if let Some(&(a, b)) = open.first() {
-            return Err(Error::InvalidOption(format!(
-                "the mesh has {} open edges (holes or a border), e.g. from {a} to {b}; an open \
-                 surface has no inside, so the side of a grid point is not defined and remeshing \
-                 it would invent one: close the holes first",
-                open.len()
-            )));
-        }
+        let open_edges = open_edges(mesh).len();
         let flipped = volume < 0.0;
         if flipped {
             for t in &mut triangles {
@@ -117,7 +126,8 @@ impl MeshBvh {
             triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bvh = Bvh::build(&boxes);
-        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped })
+        let winding = (open_edges > 0).then(|| WindingTree::new(&triangles));
+        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped, open_edges, winding })
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -376,14 +386,22 @@ fn closest_point_on_triangle(p: Vec3, [a, b, c]: &[Vec3; 3]) -> Vec3 {
     *a + ab * (vb / sum) + ac * (vc / sum)
 }
 
-/// Signed values at the grid points: negative inside (by [`MeshBvh::inside_votes`], two of three),
+/// Signed values at the grid points: negative inside (by [`MeshBvh::inside_votes`], two of three;
+/// for a mesh with holes, where the generalised winding number is at least 1/2),
 /// positive outside. What matters for EMC is the sign; the magnitude is the distance to the
 /// nearest triangle at every point with a neighbour of the other sign (the only values Marching
 /// Cubes interpolates, and those are within a cell of the surface), and two cells elsewhere. An
 /// inside point on the surface gets the smallest negative float, so its sign survives.
 pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
-    let votes = mesh.inside_votes(grid);
-    let inside: Vec<bool> = votes.iter().map(|&v| v >= 2).collect();
+    let inside: Vec<bool> = match &mesh.winding {
+        Some(tree) => (0..grid.point_count())
+            .map(|n| {
+                let [i, j, k] = grid.unindex(n);
+                tree.winding(grid.position(i, j, k)) >= 0.5
+            })
+            .collect(),
+        None => mesh.inside_votes(grid).iter().map(|&v| v >= 2).collect(),
+    };
     let band = 2.0 * grid.cell_size();
     let pts = grid.points();
     let mut values = vec![0.0f32; grid.point_count()];
@@ -593,7 +611,7 @@ mod tests {
     }
 
     #[test]
-    fn open_meshes_are_refused_and_closed_ones_counted_by_position() {
+    fn open_edges_are_counted_by_position() {
         let m = cube();
         // Every face's vertices split apart (as an STL would have them): still closed.
         let mut split = Mesh::default();
@@ -612,8 +630,8 @@ mod tests {
         let mut holed = m.clone();
         holed.triangles.remove(5);
         assert_eq!(open_edges(&holed).len(), 3);
-        let err = MeshBvh::new(&holed).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(err.contains("3 open edges (holes or a border)"), "{err}");
+        assert_eq!(MeshBvh::new(&holed).unwrap().open_edges, 3);
+        assert_eq!(MeshBvh::new(&m).unwrap().open_edges, 0);
         // A face wound the wrong way round is not a hole.
         let mut misturned = m.clone();
         misturned.triangles[5].swap(1, 2);

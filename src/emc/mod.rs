@@ -24,6 +24,7 @@ mod plan;
 pub mod point_source;
 pub mod resample;
 pub mod untangle;
+pub mod winding;
 
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
