@@ -126,6 +126,54 @@ fn remeshing_an_emc_mesh_of_a_scene_reproduces_it() {
     }
 }
 
+/// A sphere mesh with four holes (like the shark, whose four holes made 5–20 components
+/// with sheets at the rims): the generalised winding number spans each hole, so the remesh is one
+/// closed sphere, and nearly all of it lies on the input.
+#[test]
+fn a_sphere_with_four_holes_remeshes_into_one_closed_sphere() {
+    let c = Vec3::new(0.02, -0.03, 0.01);
+    let sphere =
+        pipeline::mesh_expr("translate(sphere(0.7), 0.02, -0.03, 0.01)", &request(Method::Mc, 40)).unwrap();
+    let mut holed = sphere.mesh.clone();
+    let holes =
+        [Vec3::X, -Vec3::Y, Vec3::new(-0.6, 0.0, 0.8), Vec3::new(0.0, 0.6, -0.8)].map(|d| c + d * 0.7);
+    holed.triangles.retain(|t| {
+        let centroid = t.iter().map(|&v| holed.positions[v as usize]).sum::<Vec3>() / 3.0;
+        holes.iter().all(|h| (centroid - *h).length() > 0.15)
+    });
+    let removed = sphere.mesh.triangle_count() - holed.triangle_count();
+    let area = |m: &isoforge::Mesh| {
+        (0..m.triangle_count())
+            .map(|t| {
+                let [a, b, c] = m.corners(t);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum::<f32>()
+    };
+    let holes_share = 1.0 - area(&holed) / area(&sphere.mesh);
+    let source = isoforge::emc::mesh_source::MeshBvh::new(&holed).unwrap();
+    assert!(source.open_edges > 40, "{} open edges", source.open_edges);
+    for method in [Method::Emc, Method::Mc] {
+        let out = pipeline::mesh_triangles(&holed, &request(method, 32)).unwrap();
+        let what = format!("sphere with 4 holes ({removed} triangles removed), {}", method.name());
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        // Vertices more than a cell from the holed input (inside the caps spanning the holes:
+        // fewer than the holes' share of the surface), and the largest distance from the sphere
+        // it came from, in cells.
+        let h = 1.4 / 28.0;
+        let far = out.mesh.positions.iter().filter(|&&p| source.nearest(p, h).is_none()).count() as f32
+            / out.mesh.positions.len() as f32;
+        let off = out.mesh.positions.iter().map(|&p| ((p - c).length() - 0.7).abs()).fold(0.0, f32::max) / h;
+        eprintln!("{what}: {} triangles, {:.2} % of vertices over a cell from the input (holes: {:.2} % of the area), at most {off:.2} cells off the sphere", out.stats.triangles, 100.0 * far, 100.0 * holes_share);
+        assert!(
+            far < holes_share,
+            "{what}: {far} of the vertices over a cell from the input, holes {holes_share}"
+        );
+        assert!(off < 1.0, "{what}: a vertex {off} cells off the sphere");
+    }
+}
+
 /// `n` points on a sphere of radius `r` about `c` (a Fibonacci lattice), normals outward.
 fn sphere_cloud(n: usize, r: f32, c: Vec3) -> PointCloud {
     let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());

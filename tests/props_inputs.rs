@@ -127,7 +127,7 @@ fn assert_open_only_on_the_grid(out: &Output, grid: &Grid, what: &str) -> analys
 }
 
 /// A closed mesh with 1–5 random triangles removed (punched holes), remeshed by MC, EMC and DMC
-/// at 16–27 cells: inside is where the generalised winding number is at least 1/2, so the holes
+/// at 16–27 cells: inside is where the generalised winding number exceeds 1/2, so the holes
 /// are spanned and the output is closed with the topology (Euler characteristic, components) of
 /// the same method's remesh of the mesh before the damage. The open edges are counted: those of the removed
 /// triangles that the rest of the mesh still uses once (an edge two removed triangles share is

@@ -1,10 +1,13 @@
 //! Directed distances from a closed triangle mesh (paper §3.1, "Polygonal meshes"): EMC as a
-//! remesher (§5.3). For a mesh with holes or a border ([`open_edges`]) the votes below are not
-//! defined (a line through a hole counts one crossing too few from there on) and inside is where
-//! the generalised winding number ([`super::winding`]) is at least 1/2 instead: the holes are
-//! closed by a surface spanning their rims. Every edge crossing is where an axis-aligned ray from the grid point first
+//! remesher (§5.3). Every edge crossing is where an axis-aligned ray from the grid point first
 //! meets a triangle, and its normal is that triangle's, so sharp edges and corners of the input
 //! come back as feature lines and corners of the output.
+//!
+//! For a mesh with holes or a border ([`open_edges`]) the votes below are not defined (a line
+//! through a hole counts one crossing too few from there on), and inside is where the generalised
+//! winding number ([`super::winding`]) exceeds 1/2 instead: the holes are closed by a surface
+//! spanning their rims, with crossings interpolated where a grid edge passes through a hole. A
+//! mesh that bounds nothing (a sheet) is refused ([`check_encloses`]).
 //!
 //! Three queries over one [`MeshBvh`] (a bounding volume hierarchy over the triangles):
 //! - **inside or outside** at every grid point: the winding number of the mesh around the point,
@@ -387,7 +390,7 @@ fn closest_point_on_triangle(p: Vec3, [a, b, c]: &[Vec3; 3]) -> Vec3 {
 }
 
 /// Signed values at the grid points: negative inside (by [`MeshBvh::inside_votes`], two of three;
-/// for a mesh with holes, where the generalised winding number is at least 1/2),
+/// for a mesh with holes, where the generalised winding number exceeds 1/2),
 /// positive outside. What matters for EMC is the sign; the magnitude is the distance to the
 /// nearest triangle at every point with a neighbour of the other sign (the only values Marching
 /// Cubes interpolates, and those are within a cell of the surface), and two cells elsewhere. An
@@ -397,7 +400,7 @@ pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
         Some(tree) => (0..grid.point_count())
             .map(|n| {
                 let [i, j, k] = grid.unindex(n);
-                tree.winding(grid.position(i, j, k)) >= 0.5
+                tree.winding(grid.position(i, j, k)) > 0.5
             })
             .collect(),
         None => mesh.inside_votes(grid).iter().map(|&v| v >= 2).collect(),
@@ -431,6 +434,22 @@ pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
         }
     }
     values
+}
+
+/// Refuses the grid values of a mesh with holes where no grid point is inside: an open surface
+/// that bounds nothing (a sheet, a lone face) has a winding number below 1/2 everywhere, and an
+/// empty output would say nothing about why. A closed mesh whose solid falls between the grid
+/// points meshes to nothing as any surface smaller than a cell does.
+pub fn check_encloses(mesh: &MeshBvh, values: &[f32]) -> Result<(), Error> {
+    if mesh.open_edges > 0 && !values.iter().any(|&v| v < 0.0) {
+        return Err(Error::InvalidOption(format!(
+            "the mesh has {} open edges (holes or a border) and encloses nothing: its generalised \
+             winding number is below 1/2 at every grid point, so it is a sheet rather than the \
+             surface of a solid",
+            mesh.open_edges
+        )));
+    }
+    Ok(())
 }
 
 /// EMC's edge crossings on a triangle mesh: the first ray hit along the edge and the hit
@@ -482,6 +501,7 @@ pub fn remesh(mesh: &Mesh, grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh
     let t0 = Instant::now();
     let source = MeshBvh::new(mesh)?;
     let values = grid_values(&source, grid);
+    check_encloses(&source, &values)?;
     let sample_ms = ms_since(t0);
     let sampler = MeshRays { mesh: &source, directed: options.directed };
     let (mut out, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;
@@ -641,6 +661,20 @@ mod tests {
         let mut sliver = holed.clone();
         sliver.triangles.push([0, 0, 1]);
         assert_eq!(open_edges(&sliver).len(), 3);
+    }
+
+    #[test]
+    fn sheets_are_refused() {
+        let square = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            normals: vec![],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        let source = MeshBvh::new(&square).unwrap();
+        assert_eq!(source.open_edges, 4);
+        let grid = padded_grid(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), 12).unwrap();
+        let err = check_encloses(&source, &grid_values(&source, &grid)).unwrap_err().to_string();
+        assert!(err.contains("4 open edges") && err.contains("encloses nothing"), "{err}");
     }
 
     #[test]

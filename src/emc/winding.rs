@@ -142,11 +142,16 @@ impl WindingTree {
 }
 
 /// Signed solid angle of triangle `t` seen from `p` (Van Oosterom and Strackee 1983): positive
-/// when `p` lies behind it (on the side its counter-clockwise normal points away from).
+/// when `p` lies behind it (on the side its counter-clockwise normal points away from). From a
+/// point in the triangle's plane it is 0: inside the triangle the formula gives ±2π by the sign of
+/// a zero, which would put points on a sheet at a winding number of ±1/2 by chance.
 fn solid_angle(t: &[DVec3; 3], p: DVec3) -> f64 {
     let (a, b, c) = (t[0] - p, t[1] - p, t[2] - p);
     let (la, lb, lc) = (a.length(), b.length(), c.length());
     let numerator = a.dot(b.cross(c));
+    if numerator == 0.0 {
+        return 0.0;
+    }
     let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
     2.0 * numerator.atan2(denominator)
 }

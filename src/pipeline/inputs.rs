@@ -71,8 +71,9 @@ fn iso_must_be_zero(request: &Request, what: &str) -> Result<(), Error> {
     Ok(())
 }
 
-/// Remeshes a closed triangle mesh (counter-clockwise seen from outside, or consistently the
-/// other way round, which is detected and turned around).
+/// Remeshes a triangle mesh (counter-clockwise seen from outside, or consistently the other way
+/// round, which is detected and turned around). A mesh with holes is meshed by its generalised
+/// winding number, which spans them; one that bounds nothing (a sheet) is refused.
 pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
     iso_must_be_zero(request, "remeshing a triangle mesh (the surface is the mesh)")?;
     let bounds = mesh_bounds(mesh);
@@ -86,6 +87,7 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
         _ => {
             let t0 = web_time::Instant::now();
             let values = mesh_source::grid_values(&source, &grid);
+            mesh_source::check_encloses(&source, &values)?;
             mesh_signed_values(&values, &grid, request, mc::ms_since(t0))?
         }
     };
