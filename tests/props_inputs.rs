@@ -223,6 +223,20 @@ fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
             .map(|&p| program.gradient(p).unwrap_or(Vec3::Z).normalize_or(Vec3::Z))
             .collect();
         let cloud = PointCloud { positions: source.positions.clone(), normals };
+        // The normals are exact: orientation may turn a few where parts are thinner than the
+        // samples' spacing (the two faces of a shell thinning to nothing read as flipped where
+        // they meet), never a face. Measured over 100 trees: none in 86, at most 1.9 % of a cloud
+        // of 748 (and 48 of a 232-sample speck, not asserted).
+        let mut oriented = cloud.clone();
+        let turned = isoforge::emc::orient::orient_normals(&mut oriented)
+            .unwrap_or_else(|e| panic!("seed {seed}: exact normals refused: {e}"));
+        if cloud.len() >= 500 {
+            assert!(
+                turned * 33 <= cloud.len(),
+                "seed {seed}: {turned} of {} exact normals turned",
+                cloud.len()
+            );
+        }
         let res = 12 + rng.below(12) as usize;
         let what = format!("seed {seed}, res {res}, {} points of {text}", cloud.positions.len());
         let mc = pipeline::mesh_points(&cloud, &bare_request(Method::Mc, res))

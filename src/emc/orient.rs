@@ -9,14 +9,17 @@
 //!    flipped, near 0 for "cannot tell" (across a sharp edge, where the normals are orthogonal).
 //! 2. Pairs on one smooth sheet whose normals clearly agree as given join into patches
 //!    (union-find).
-//! 3. Patches are joined into groups, strongest summed evidence first (Kruskal's order, as in the
+//! 3. Patches are joined into groups where the pairs between them clearly agree or clearly
+//!    disagree on average, strongest summed evidence first (Kruskal's order, as in the
 //!    minimum spanning tree of Hoppe et al. 1992, but over patches, so one unlucky pair cannot
 //!    turn a large region around), each join recording whether one patch is turned relative to the
 //!    other.
 //! 4. In each group the orientation most of its samples already have wins; the others are turned.
-//! 5. Each patch is turned only where most of the evidence on its own links agrees with that
-//!    (a sample alone on a sliver of a face at a corner has only votes across sharp edges, which
-//!    can contradict each other; it keeps the normal it came with).
+//! 5. A region of patches to be turned is turned only where 3/4 of the evidence across its border
+//!    agrees and there is at least the square root of its size of it (a sample alone on a sliver
+//!    of a face at a corner has only votes across sharp edges, which can contradict each other,
+//!    and the inside of a shell thinning to nothing meets the outside in a few pairs that read as
+//!    flipped; both keep the normals they came with).
 //! 6. A group holding one of the cloud's six extreme samples (largest and smallest x, y, z), whose
 //!    outward normal must point away from the cloud along that axis, is turned around as a whole
 //!    when those samples say it is inside out (a cloud exported with inward normals), as inside-out
@@ -40,6 +43,9 @@ const AGREE: f32 = 0.5;
 
 /// Patches are joined only on summed evidence of at least this (a single pair's clear vote).
 const EVIDENCE: f32 = 0.5;
+
+/// Patches are joined only where the mean vote of the pairs between them is at least this.
+const CLEAR: f32 = 0.5;
 
 /// A group whose minority holds more than this share of its samples is split too evenly for a
 /// majority to mean anything.
@@ -186,19 +192,26 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
     }
     let patch: Vec<u32> = (0..n as u32).map(|i| patches.find(i).0).collect();
 
-    // Evidence between patches, then Kruskal over it, strongest first.
-    let mut evidence: HashMap<(u32, u32), f32> = HashMap::new();
+    // Evidence between patches (summed votes, pairs), then Kruskal over it, strongest first. A
+    // link joins two patches only where the pairs between them clearly agree on average: the two
+    // faces of a wall about as thin as the samples' spacing are two patches with many pairs
+    // between them that abstain and a few that read as flipped, which must not turn one face.
+    let mut evidence: HashMap<(u32, u32), (f32, u32)> = HashMap::new();
     for (&(i, j), &v) in pairs.iter().zip(&votes) {
         let (a, b) = (patch[i as usize], patch[j as usize]);
         if a != b {
-            *evidence.entry((a.min(b), a.max(b))).or_insert(0.0) += v;
+            let e = evidence.entry((a.min(b), a.max(b))).or_insert((0.0, 0));
+            e.0 += v;
+            e.1 += 1;
         }
     }
-    let mut links: Vec<((u32, u32), f32)> = evidence.into_iter().collect();
+    let mut links: Vec<((u32, u32), f32, u32)> = evidence.into_iter().map(|(k, (e, c))| (k, e, c)).collect();
     links.sort_unstable_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
     let mut groups = Parity::new(n);
-    for &((a, b), e) in links.iter().take_while(|l| l.1.abs() >= EVIDENCE) {
-        groups.union(a, b, e < 0.0);
+    for &((a, b), e, count) in &links {
+        if e.abs() >= EVIDENCE && e.abs() >= CLEAR * count as f32 {
+            groups.union(a, b, e < 0.0);
+        }
     }
 
     // Per sample: its group and whether it is turned relative to the group's root.
@@ -293,7 +306,7 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
     }
     // (evidence for turning, total evidence) per patch
     let mut support: HashMap<u32, (f32, f32)> = HashMap::new();
-    for &((a, b), e) in &links {
+    for &((a, b), e, _) in &links {
         for (p, q) in [(a, b), (b, a)] {
             let other = if turn[&q] { -1.0 } else { 1.0 };
             let s = support.entry(p).or_insert((0.0, 0.0));
@@ -301,16 +314,57 @@ pub fn orient_normals(cloud: &mut PointCloud) -> Result<usize, Error> {
             s.1 += e.abs();
         }
     }
-    for (p, t) in turn.iter_mut() {
-        if let Some(&(for_turning, total)) = support.get(p) {
-            let overruled = for_turning >= 0.5 * total && total >= EVIDENCE;
-            *t = if unsettled.contains(&groups.find(*p).0) {
-                overruled
-            } else {
-                *t && for_turning >= 0.5 * total
-            };
+    // A turned patch's rim disagrees with its surroundings all round: a flipped disc of m samples
+    // has some 3.5 √m on its rim and each of those about 5 pairs across it, so its evidence grows
+    // like 17 √m. Asking for √m keeps a large region from being turned by a handful of pairs (the
+    // two faces of a wall thinning to nothing, as the inside of a shell does, read as flipped
+    // where they meet). Patches to be turned are judged together with the turned patches they
+    // link to, by the evidence across the border of that region to patches that stay, since
+    // within the region they agree with each other either way.
+    let mut patch_size: HashMap<u32, f32> = HashMap::new();
+    for &p in &patch {
+        *patch_size.entry(p).or_insert(0.0) += 1.0;
+    }
+    let mut regions = Parity::new(n);
+    for &((a, b), _, _) in &links {
+        if turn[&a] && turn[&b] {
+            regions.union(a, b, false);
         }
     }
+    // (evidence for turning, total evidence, samples) per region, across its border
+    let mut border: HashMap<u32, (f32, f32, f32)> = HashMap::new();
+    for (&p, &t) in &turn {
+        if t {
+            border.entry(regions.find(p).0).or_insert((0.0, 0.0, 0.0)).2 += patch_size[&p];
+        }
+    }
+    for &((a, b), e, _) in &links {
+        for (p, q) in [(a, b), (b, a)] {
+            if turn[&p] && !turn[&q] {
+                let s = border.get_mut(&regions.find(p).0).expect("every turned patch has a region");
+                s.0 -= e;
+                s.1 += e.abs();
+            }
+        }
+    }
+    let clear = |(for_turning, total, size): (f32, f32, f32)| {
+        for_turning >= 0.5 * total && for_turning >= size.sqrt()
+    };
+    let mut decided = HashMap::new();
+    for (&p, &t) in &turn {
+        let keep_turned = if unsettled.contains(&groups.find(p).0) {
+            // Nothing proposed; turned only where its own neighbours overrule it.
+            support.get(&p).is_some_and(|&(f, total)| total >= EVIDENCE && clear((f, total, patch_size[&p])))
+        } else {
+            // A region with no border at all is a whole group turned (inside out): no vote across.
+            t && {
+                let b = border[&regions.find(p).0];
+                b.1 == 0.0 || clear(b)
+            }
+        };
+        decided.insert(p, keep_turned);
+    }
+    let turn = decided;
     let mut changed = 0;
     for i in 0..n {
         if turn[&patch[i]] {
