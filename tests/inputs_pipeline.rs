@@ -260,6 +260,40 @@ fn a_ball_with_92_flipped_normals_reconstructs_as_the_ball() {
     }
 }
 
+/// A box whose three faces on the negative sides carry normals pointing in, as in CGAL's
+/// cube.pwn (every normal along a positive axis): half the normals are wrong, so no majority can
+/// tell, but the sharp edges relate the faces and the extreme samples say which way is out.
+#[test]
+fn a_box_with_its_negative_faces_turned_in_is_oriented() {
+    let mut rng = Rng::new(17);
+    let (mut truth, mut cloud) = (PointCloud::default(), PointCloud::default());
+    let half = Vec3::new(0.5, 0.4, 0.3);
+    let rotation = glam::Quat::from_axis_angle(Vec3::new(1.0, 1.0, 2.0).normalize(), 0.4);
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            for _ in 0..3000 {
+                let mut p =
+                    Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
+                p[axis] = side * half[axis];
+                let mut n = Vec3::ZERO;
+                n[axis] = 1.0;
+                truth.positions.push(rotation * p);
+                truth.normals.push(rotation * (n * side));
+                cloud.positions.push(rotation * p);
+                cloud.normals.push(rotation * n);
+            }
+        }
+    }
+    let mut oriented = cloud.clone();
+    assert_eq!(isoforge::emc::orient::orient_normals(&mut oriented).unwrap(), 9000);
+    assert_eq!(oriented, truth);
+    let out = pipeline::mesh_points(&cloud, &request(Method::Emc, 32)).unwrap();
+    let topo = assert_watertight(&out.mesh, "box with three faces turned in");
+    assert_eq!((topo.euler, topo.components), (2, 1));
+    let right = pipeline::mesh_points(&truth, &request(Method::Emc, 32)).unwrap();
+    assert_eq!(out.mesh.positions, right.mesh.positions, "the mesh of the box with its normals right");
+}
+
 /// Clouds whose normals cannot be made consistent are refused; a cloud exported inside out is
 /// turned around, like an inside-out mesh.
 #[test]
