@@ -324,9 +324,14 @@ fn point_clouds_are_reconstructed() {
         let (x, y) = (rho * a.cos(), rho * a.sin());
         text += &format!("{} {} {} {x} {y} {z}\n", 0.6 * x, 0.6 * y, 0.6 * z);
     }
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, &text).unwrap();
     let s = stats(&["mesh", "--points", path.to_str().unwrap(), "--method", "emc", "--res", "20"]);
     assert_eq!((s["closed_manifold"].clone(), s["euler"].clone()), (true.into(), 2.into()));
+    // The same points as CGAL's .pwn, with its count line: the same mesh.
+    let pwn = scratch("sphere.pwn");
+    std::fs::write(&pwn, format!("{n}\n{}", text.trim_start_matches("# x y z nx ny nz\n"))).unwrap();
+    let p = stats(&["mesh", "--points", pwn.to_str().unwrap(), "--method", "emc", "--res", "20"]);
+    assert_eq!((p["triangles"].clone(), p["euler"].clone()), (s["triangles"].clone(), s["euler"].clone()));
     // The grid covers the input's bounds padded by two cells: a box wider than that would make
     // the cells (and so the triangles) larger.
     let wide =
@@ -354,6 +359,10 @@ fn malformed_mesh_and_point_files_name_the_file_and_line() {
     std::fs::write(&bad, "0 0 0 0 0 1\n1 2 3\n").unwrap();
     let err = fails(&["mesh", "--points", bad.to_str().unwrap()]);
     assert!(err.contains("bad.xyz") && err.contains("line 2"), "{err}");
+    let bad = scratch("bad.pwn");
+    std::fs::write(&bad, "3\n0 0 0 0 0 1\n1 2 3 0 1 0\n").unwrap();
+    let err = fails(&["mesh", "--points", bad.to_str().unwrap()]);
+    assert!(err.contains("bad.pwn") && err.contains("PWN line 1") && err.contains("declares 3"), "{err}");
     let err = fails(&["mesh", "--mesh", scratch("missing.stl").to_str().unwrap()]);
     assert!(err.contains("missing.stl"), "{err}");
     let err = fails(&["mesh", "--mesh", bad.to_str().unwrap(), "--scene", "sphere"]);

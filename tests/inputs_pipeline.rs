@@ -126,6 +126,54 @@ fn remeshing_an_emc_mesh_of_a_scene_reproduces_it() {
     }
 }
 
+/// A sphere mesh with four holes (like the shark, whose four holes made 5–20 components
+/// with sheets at the rims): the generalised winding number spans each hole, so the remesh is one
+/// closed sphere, and nearly all of it lies on the input.
+#[test]
+fn a_sphere_with_four_holes_remeshes_into_one_closed_sphere() {
+    let c = Vec3::new(0.02, -0.03, 0.01);
+    let sphere =
+        pipeline::mesh_expr("translate(sphere(0.7), 0.02, -0.03, 0.01)", &request(Method::Mc, 40)).unwrap();
+    let mut holed = sphere.mesh.clone();
+    let holes =
+        [Vec3::X, -Vec3::Y, Vec3::new(-0.6, 0.0, 0.8), Vec3::new(0.0, 0.6, -0.8)].map(|d| c + d * 0.7);
+    holed.triangles.retain(|t| {
+        let centroid = t.iter().map(|&v| holed.positions[v as usize]).sum::<Vec3>() / 3.0;
+        holes.iter().all(|h| (centroid - *h).length() > 0.15)
+    });
+    let removed = sphere.mesh.triangle_count() - holed.triangle_count();
+    let area = |m: &isoforge::Mesh| {
+        (0..m.triangle_count())
+            .map(|t| {
+                let [a, b, c] = m.corners(t);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum::<f32>()
+    };
+    let holes_share = 1.0 - area(&holed) / area(&sphere.mesh);
+    let source = isoforge::emc::mesh_source::MeshBvh::new(&holed).unwrap();
+    assert!(source.open_edges > 40, "{} open edges", source.open_edges);
+    for method in [Method::Emc, Method::Mc] {
+        let out = pipeline::mesh_triangles(&holed, &request(method, 32)).unwrap();
+        let what = format!("sphere with 4 holes ({removed} triangles removed), {}", method.name());
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        // Vertices more than a cell from the holed input (inside the caps spanning the holes:
+        // fewer than the holes' share of the surface), and the largest distance from the sphere
+        // it came from, in cells.
+        let h = 1.4 / 28.0;
+        let far = out.mesh.positions.iter().filter(|&&p| source.nearest(p, h).is_none()).count() as f32
+            / out.mesh.positions.len() as f32;
+        let off = out.mesh.positions.iter().map(|&p| ((p - c).length() - 0.7).abs()).fold(0.0, f32::max) / h;
+        eprintln!("{what}: {} triangles, {:.2} % of vertices over a cell from the input (holes: {:.2} % of the area), at most {off:.2} cells off the sphere", out.stats.triangles, 100.0 * far, 100.0 * holes_share);
+        assert!(
+            far < holes_share,
+            "{what}: {far} of the vertices over a cell from the input, holes {holes_share}"
+        );
+        assert!(off < 1.0, "{what}: a vertex {off} cells off the sphere");
+    }
+}
+
 /// `n` points on a sphere of radius `r` about `c` (a Fibonacci lattice), normals outward.
 fn sphere_cloud(n: usize, r: f32, c: Vec3) -> PointCloud {
     let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
@@ -157,6 +205,115 @@ fn a_sampled_sphere_reconstructs_closed_near_the_sphere() {
         );
         assert!(off < 0.05, "{what}: a vertex is {off} cells off the sphere");
     }
+}
+
+/// The ball.ply: 31 374 samples of a ball with 92 normals pointing in, scattered (60) and
+/// in a patch (32). Unoriented, that reconstructs into a sphere full of bubbles and holes; the
+/// pipeline turns the 92 back first and meshes the sphere.
+#[test]
+fn a_ball_with_92_flipped_normals_reconstructs_as_the_ball() {
+    let c = Vec3::new(0.03, -0.02, 0.01);
+    let truth = sphere_cloud(31374, 0.7, c);
+    let mut cloud = truth.clone();
+    let mut rng = Rng::new(92);
+    let mut flipped = std::collections::BTreeSet::new();
+    while flipped.len() < 60 {
+        flipped.insert(rng.below(31374) as usize);
+    }
+    // A patch: the 32 samples nearest to one of them (a Fibonacci lattice's neighbours in index
+    // are not its neighbours on the sphere, so by distance).
+    let centre = truth.positions[12345];
+    let mut by_distance: Vec<usize> = (0..truth.len()).filter(|i| !flipped.contains(i)).collect();
+    by_distance.sort_by(|&a, &b| {
+        (truth.positions[a] - centre).length().total_cmp(&(truth.positions[b] - centre).length())
+    });
+    flipped.extend(by_distance.into_iter().take(32));
+    for &i in &flipped {
+        cloud.normals[i] = -cloud.normals[i];
+    }
+    assert_eq!(flipped.len(), 92);
+
+    // What orientation undoes: EMC straight on the damaged normals.
+    let grid =
+        isoforge::emc::mesh_source::padded_grid(c - Vec3::splat(0.7), c + Vec3::splat(0.7), 32).unwrap();
+    let (raw, _) =
+        isoforge::emc::point_source::reconstruct(&cloud, &grid, &isoforge::emc::EmcOptions::default())
+            .unwrap();
+    let raw_topo = isoforge::mesh::analysis::topology(&raw.mesh);
+    eprintln!(
+        "ball, 92 of 31374 normals flipped, unoriented: {} components, {} boundary edges, euler {}",
+        raw_topo.components, raw_topo.boundary_edges, raw_topo.euler
+    );
+    assert_ne!((raw_topo.components, raw_topo.euler), (1, 2), "the damage must matter for this test to");
+
+    let mut oriented = cloud.clone();
+    assert_eq!(isoforge::emc::orient::orient_normals(&mut oriented).unwrap(), 92);
+    assert_eq!(oriented, truth);
+    for method in [Method::Emc, Method::Mc] {
+        let out = pipeline::mesh_points(&cloud, &request(method, 32)).unwrap();
+        let what = format!("ball with 92 flipped normals, {}", method.name());
+        let topo = assert_watertight(&out.mesh, &what);
+        assert_eq!((topo.euler, topo.components), (2, 1), "{what}");
+        let h = 1.4 / 28.0;
+        let off = out.mesh.positions.iter().map(|&p| ((p - c).length() - 0.7).abs()).fold(0.0, f32::max) / h;
+        assert!(off < 0.05, "{what}: a vertex is {off} cells off the sphere");
+    }
+}
+
+/// A box whose three faces on the negative sides carry normals pointing in, as in CGAL's
+/// cube.pwn (every normal along a positive axis): half the normals are wrong, so no majority can
+/// tell, but the sharp edges relate the faces and the extreme samples say which way is out.
+#[test]
+fn a_box_with_its_negative_faces_turned_in_is_oriented() {
+    let mut rng = Rng::new(17);
+    let (mut truth, mut cloud) = (PointCloud::default(), PointCloud::default());
+    let half = Vec3::new(0.5, 0.4, 0.3);
+    let rotation = glam::Quat::from_axis_angle(Vec3::new(1.0, 1.0, 2.0).normalize(), 0.4);
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            for _ in 0..3000 {
+                let mut p =
+                    Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
+                p[axis] = side * half[axis];
+                let mut n = Vec3::ZERO;
+                n[axis] = 1.0;
+                truth.positions.push(rotation * p);
+                truth.normals.push(rotation * (n * side));
+                cloud.positions.push(rotation * p);
+                cloud.normals.push(rotation * n);
+            }
+        }
+    }
+    let mut oriented = cloud.clone();
+    assert_eq!(isoforge::emc::orient::orient_normals(&mut oriented).unwrap(), 9000);
+    assert_eq!(oriented, truth);
+    let out = pipeline::mesh_points(&cloud, &request(Method::Emc, 32)).unwrap();
+    let topo = assert_watertight(&out.mesh, "box with three faces turned in");
+    assert_eq!((topo.euler, topo.components), (2, 1));
+    let right = pipeline::mesh_points(&truth, &request(Method::Emc, 32)).unwrap();
+    assert_eq!(out.mesh.positions, right.mesh.positions, "the mesh of the box with its normals right");
+}
+
+/// Clouds whose normals cannot be made consistent are refused; a cloud exported inside out is
+/// turned around, like an inside-out mesh.
+#[test]
+fn unoriented_clouds_are_refused_and_inside_out_ones_turned() {
+    let mut rng = Rng::new(5);
+    let mut random = sphere_cloud(4000, 0.7, Vec3::ZERO);
+    // An inner sphere with random signs: its extremes are not the cloud's.
+    for (p, n) in
+        sphere_cloud(3000, 0.3, Vec3::ZERO).positions.iter().zip(sphere_cloud(3000, 0.3, Vec3::ZERO).normals)
+    {
+        random.positions.push(*p);
+        random.normals.push(if rng.below(2) == 0 { n } else { -n });
+    }
+    let err = pipeline::mesh_points(&random, &request(Method::Emc, 24)).unwrap_err().to_string();
+    assert!(err.contains("not oriented") && err.contains("of the 7000 points"), "{err}");
+    let mut inward = sphere_cloud(4000, 0.7, Vec3::ZERO);
+    inward.normals.iter_mut().for_each(|n| *n = -*n);
+    let out = pipeline::mesh_points(&inward, &request(Method::Emc, 24)).unwrap();
+    let topo = assert_watertight(&out.mesh, "inside-out sphere cloud");
+    assert_eq!((topo.euler, topo.components), (2, 1));
 }
 
 #[test]

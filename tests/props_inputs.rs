@@ -126,6 +126,50 @@ fn assert_open_only_on_the_grid(out: &Output, grid: &Grid, what: &str) -> analys
     topo
 }
 
+/// A closed mesh with 1–5 random triangles removed (punched holes), remeshed by MC, EMC and DMC
+/// at 16–27 cells: inside is where the generalised winding number exceeds 1/2, so the holes
+/// are spanned and the output is closed with the topology (Euler characteristic, components) of
+/// the same method's remesh of the mesh before the damage. The open edges are counted: those of the removed
+/// triangles that the rest of the mesh still uses once (an edge two removed triangles share is
+/// gone entirely).
+#[test]
+fn prop_meshes_with_holes_remesh_with_the_closed_meshs_topology() {
+    for seed in case_seeds(8_500_000, CI_CASES / 2) {
+        let mut rng = Rng::new(seed);
+        let (source, text) = source_mesh(&mut rng, 12);
+        let res = 16 + rng.below(12) as usize;
+        let mut holed = source.clone();
+        let mut removed = Vec::new();
+        for _ in 0..1 + rng.below(5) {
+            removed.push(holed.triangles.swap_remove(rng.below(holed.triangles.len() as u64) as usize));
+        }
+        let mut edges = std::collections::HashMap::new();
+        for t in &removed {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let open = edges.values().filter(|&&n| n == 1).count();
+        let what =
+            format!("seed {seed}, res {res}, {} triangles removed from the mesh of {text}", removed.len());
+        assert_eq!(isoforge::emc::mesh_source::MeshBvh::new(&holed).unwrap().open_edges, open, "{what}");
+        for method in [Method::Mc, Method::Emc, Method::Dmc] {
+            let closed = pipeline::mesh_triangles(&source, &bare_request(method, res)).unwrap();
+            let closed_topo = assert_closed(&closed, &format!("{}, closed source, {what}", method.name()));
+            let out = pipeline::mesh_triangles(&holed, &bare_request(method, res))
+                .unwrap_or_else(|e| panic!("{what}: {} refused it: {e}", method.name()));
+            let topo = assert_closed(&out, &format!("{}, {what}", method.name()));
+            assert_eq!(
+                (topo.euler, topo.components),
+                (closed_topo.euler, closed_topo.components),
+                "{}, {what}",
+                method.name()
+            );
+        }
+    }
+}
+
 /// Closed inputs and damaged ones alike: MC and EMC accept them and mesh a closed, outward
 /// manifold; EMC has MC's Euler characteristic and components on the same grid; a duplicated or
 /// zero-area triangle changes nothing but the input's face count; an inside-out mesh meshes like
@@ -163,10 +207,10 @@ fn prop_meshes_remesh_closed_with_mcs_topology() {
 
 /// Oriented point clouds sampled densely from a random tree's surface (the vertices of its MC mesh
 /// at 40–49 cells, with the program's exact normals), reconstructed at 12–23 cells by MC and EMC:
-/// an oriented manifold, open only on the grid's faces, EMC with MC's topology. Not closed in
-/// general: where a part is thinner than the samples' spacing, the nearest sample to a grid point
-/// outside may lie on the far sheet and face away from it, so the point counts as inside, even
-/// on the grid's border (the README says so).
+/// closed (grid points more than a cell outside the samples' box are outside, and the grid reaches
+/// two cells beyond it), an oriented manifold, EMC with MC's topology. The topology need not be
+/// the tree's: where a part is thinner than the samples' spacing, the nearest sample to a grid
+/// point outside may lie on the far sheet and face away from it.
 #[test]
 fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
     for seed in case_seeds(6_500_000, CI_CASES) {
@@ -179,6 +223,20 @@ fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
             .map(|&p| program.gradient(p).unwrap_or(Vec3::Z).normalize_or(Vec3::Z))
             .collect();
         let cloud = PointCloud { positions: source.positions.clone(), normals };
+        // The normals are exact: orientation may turn a few where parts are thinner than the
+        // samples' spacing (the two faces of a shell thinning to nothing read as flipped where
+        // they meet), never a face. Measured over 100 trees: none in 86, at most 1.9 % of a cloud
+        // of 748 (and 48 of a 232-sample speck, not asserted).
+        let mut oriented = cloud.clone();
+        let turned = isoforge::emc::orient::orient_normals(&mut oriented)
+            .unwrap_or_else(|e| panic!("seed {seed}: exact normals refused: {e}"));
+        if cloud.len() >= 500 {
+            assert!(
+                turned * 33 <= cloud.len(),
+                "seed {seed}: {turned} of {} exact normals turned",
+                cloud.len()
+            );
+        }
         let res = 12 + rng.below(12) as usize;
         let what = format!("seed {seed}, res {res}, {} points of {text}", cloud.positions.len());
         let mc = pipeline::mesh_points(&cloud, &bare_request(Method::Mc, res))
@@ -189,10 +247,193 @@ fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
         let grid = padded_grid(lo, hi, res).unwrap();
         let mc_topo = assert_open_only_on_the_grid(&mc, &grid, &format!("mc, {what}"));
         let emc_topo = assert_open_only_on_the_grid(&emc, &grid, &format!("emc, {what}"));
+        assert_eq!(mc_topo.boundary_edges, 0, "mc, {what}: open");
+        assert_eq!(emc_topo.boundary_edges, 0, "emc, {what}: open");
         assert_eq!(
             (emc_topo.euler, emc_topo.components),
             (mc_topo.euler, mc_topo.components),
             "emc vs mc, {what}"
         );
+    }
+}
+
+/// A convex part of a random shape: a ball or a box turned at random.
+#[derive(Debug, Clone, Copy)]
+enum Part {
+    Ball { centre: Vec3, radius: f32 },
+    Box { centre: Vec3, half: Vec3, rotation: glam::Quat },
+}
+
+impl Part {
+    fn random(rng: &mut Rng, centre: Vec3) -> Part {
+        if rng.below(2) == 0 {
+            Part::Ball { centre, radius: rng.range(0.25, 0.45) }
+        } else {
+            let axis = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            Part::Box {
+                centre,
+                half: Vec3::new(rng.range(0.18, 0.35), rng.range(0.18, 0.35), rng.range(0.18, 0.35)),
+                rotation: glam::Quat::from_axis_angle(axis.normalize_or(Vec3::Z), rng.range(0.0, 3.0)),
+            }
+        }
+    }
+
+    fn area(&self) -> f32 {
+        match *self {
+            Part::Ball { radius, .. } => 4.0 * std::f32::consts::PI * radius * radius,
+            Part::Box { half: h, .. } => 8.0 * (h.x * h.y + h.y * h.z + h.z * h.x),
+        }
+    }
+
+    /// Strictly inside, by more than `margin`.
+    fn contains(&self, p: Vec3, margin: f32) -> bool {
+        match *self {
+            Part::Ball { centre, radius } => (p - centre).length() < radius - margin,
+            Part::Box { centre, half, rotation } => {
+                let local = rotation.inverse() * (p - centre);
+                local.abs().cmplt(half - Vec3::splat(margin)).all()
+            }
+        }
+    }
+
+    /// A uniformly random point of the surface and its outward normal.
+    fn sample(&self, rng: &mut Rng) -> (Vec3, Vec3) {
+        match *self {
+            Part::Ball { centre, radius } => {
+                let z = rng.range(-1.0, 1.0);
+                let a = rng.range(0.0, std::f32::consts::TAU);
+                let rho = (1.0 - z * z).max(0.0).sqrt();
+                let n = Vec3::new(rho * a.cos(), rho * a.sin(), z);
+                (centre + n * radius, n)
+            }
+            Part::Box { centre, half, rotation } => {
+                let areas = [half.y * half.z, half.z * half.x, half.x * half.y];
+                let mut pick = rng.range(0.0, areas.iter().sum());
+                let mut axis = 2;
+                for (a, &area) in areas.iter().enumerate() {
+                    if pick < area {
+                        axis = a;
+                        break;
+                    }
+                    pick -= area;
+                }
+                let side = if rng.below(2) == 0 { 1.0 } else { -1.0 };
+                let mut local =
+                    Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * half;
+                local[axis] = side * half[axis];
+                let mut n = Vec3::ZERO;
+                n[axis] = side;
+                (centre + rotation * local, rotation * n)
+            }
+        }
+    }
+}
+
+/// A random shape of one or two separate components, each a box, a ball, or the union of two
+/// overlapping balls (a topological ball either way; a box and a part overlapping it can leave a
+/// sliver thinner than a cell, which reconstruction splits off), sampled by about `density`
+/// points per unit area on the surface of the union with exact outward normals. Returns the cloud,
+/// the number of components and a description.
+fn random_shape_cloud(rng: &mut Rng, density: f32) -> (PointCloud, usize, String) {
+    let components = 1 + rng.below(2) as usize;
+    let mut parts = Vec::new();
+    for c in 0..components {
+        let centre = Vec3::new(if components == 2 { c as f32 * 1.4 - 0.7 } else { 0.0 }, 0.0, 0.0)
+            + Vec3::new(rng.range(-0.1, 0.1), rng.range(-0.1, 0.1), rng.range(-0.1, 0.1));
+        let first = Part::random(rng, centre);
+        parts.push(first);
+        if matches!(first, Part::Ball { .. }) && rng.below(2) == 0 {
+            let offset = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let distance = rng.range(0.1, 0.3);
+            let radius = rng.range(0.25, 0.45);
+            parts.push(Part::Ball { centre: centre + offset.normalize_or(Vec3::Y) * distance, radius });
+        }
+    }
+    let mut cloud = PointCloud::default();
+    for (k, part) in parts.iter().enumerate() {
+        let count = (part.area() * density) as usize;
+        for _ in 0..count {
+            let (p, n) = part.sample(rng);
+            // On the union's surface: inside no other part.
+            if !parts.iter().enumerate().any(|(m, other)| m != k && other.contains(p, 0.0)) {
+                cloud.positions.push(p);
+                cloud.normals.push(n);
+            }
+        }
+    }
+    (cloud, components, format!("{parts:?}"))
+}
+
+/// Turns around a random 0–5 % of the normals: scattered single ones, and in some clouds also
+/// compact clusters (a sample's nearest neighbours). Returns how many are turned.
+fn flip_some(rng: &mut Rng, cloud: &mut PointCloud) -> usize {
+    let n = cloud.positions.len();
+    let target = (rng.range(0.0, 0.05) * n as f32) as usize;
+    let mut flipped = vec![false; n];
+    if rng.below(2) == 0 {
+        // Up to three clusters taking half the budget.
+        for _ in 0..1 + rng.below(3) {
+            let centre = cloud.positions[rng.below(n as u64) as usize];
+            let mut by_distance: Vec<usize> = (0..n).collect();
+            by_distance.sort_by(|&a, &b| {
+                (cloud.positions[a] - centre).length().total_cmp(&(cloud.positions[b] - centre).length())
+            });
+            for &i in by_distance.iter().take(target / 6) {
+                flipped[i] = true;
+            }
+        }
+    }
+    while flipped.iter().filter(|&&f| f).count() < target {
+        flipped[rng.below(n as u64) as usize] = true;
+    }
+    for (normal, _) in cloud.normals.iter_mut().zip(&flipped).filter(|(_, &f)| f) {
+        *normal = -*normal;
+    }
+    flipped.iter().filter(|&&f| f).count()
+}
+
+/// Clouds sampled from random balls, boxes and unions of two, with 0–5 % of their normals turned
+/// around (scattered, and in half the clouds partly in clusters): orientation turns those back
+/// (all of them, or all but one in 2 000 samples: see below) and no others, and the reconstruction
+/// (EMC, 16–27 cells) is closed with the topology of the undamaged cloud's, which for balls and
+/// their unions is one component per shape component, Euler characteristic 2 each; where every
+/// normal came back it is the same mesh as from the cloud before the damage.
+#[test]
+fn prop_flipped_normals_are_turned_back() {
+    for seed in case_seeds(7_500_000, CI_CASES) {
+        let mut rng = Rng::new(seed);
+        let (truth, components, shape) = random_shape_cloud(&mut rng, 6000.0);
+        let mut cloud = truth.clone();
+        let flipped = flip_some(&mut rng, &mut cloud);
+        let res = 16 + rng.below(12) as usize;
+        let what = format!("seed {seed}, res {res}, {flipped} of {} normals flipped, {shape}", truth.len());
+        let mut oriented = cloud.clone();
+        let turned = isoforge::emc::orient::orient_normals(&mut oriented)
+            .unwrap_or_else(|e| panic!("{what}: refused: {e}"));
+        let wrong = oriented.normals.iter().zip(&truth.normals).filter(|(a, b)| a != b).count();
+        // Exactly the flipped ones, but for the odd sample alone on a sliver of a face at a corner
+        // (its only neighbours across two sharp edges at once, which cannot tell it either way).
+        assert!(wrong * 2000 <= truth.len(), "{what}: {wrong} normals still wrong, {turned} turned");
+        if wrong == 0 {
+            assert_eq!(turned, flipped, "{what}: turned ones that were right");
+        }
+        let out = pipeline::mesh_points(&cloud, &bare_request(Method::Emc, res))
+            .unwrap_or_else(|e| panic!("{what}: refused: {e}"));
+        let topo = assert_closed(&out, &what);
+        let clean = pipeline::mesh_points(&truth, &bare_request(Method::Emc, res)).unwrap();
+        let clean_topo = assert_closed(&clean, &format!("undamaged, {what}"));
+        assert_eq!((topo.components, topo.euler), (clean_topo.components, clean_topo.euler), "{what}");
+        // Balls and their unions come back as what they are; a box now and then gains a bubble
+        // off an edge or corner even from undamaged normals (a reconstruction limit, not
+        // orientation's: seed 7_500_054 is one).
+        if !shape.contains("Box") {
+            assert_eq!((topo.components, topo.euler), (components, 2 * components as i64), "{what}");
+        }
+        if wrong == 0 {
+            assert_eq!(
+                out.mesh.positions, clean.mesh.positions,
+                "{what}: differs from the undamaged cloud's"
+            );
+        }
     }
 }

@@ -1,4 +1,4 @@
-//! Bytes → `input::read_points`: the first byte picks the hint (ply, xyz, or none so the content
+//! Bytes → `input::read_points`: the first byte picks the hint (ply, xyz, pwn, or none so the content
 //! is sniffed), the rest is the file. Any file may be refused; none may panic, hang or allocate
 //! by a count its header claims. A cloud that is read has one unit normal per point (the reader
 //! normalises them), which is what reconstruction relies on.
@@ -7,7 +7,7 @@
 use isoforge::input;
 use libfuzzer_sys::fuzz_target;
 
-const HINTS: [Option<&str>; 3] = [Some("ply"), Some("xyz"), None];
+const HINTS: [Option<&str>; 4] = [Some("ply"), Some("xyz"), Some("pwn"), None];
 
 fuzz_target!(|data: &[u8]| {
     let Some((&first, file)) = data.split_first() else { return };

@@ -47,12 +47,14 @@ struct MeshArgs {
     /// A file holding a program in the expression language (like --expr).
     #[arg(long, value_name = "FILE")]
     expr_file: Option<PathBuf>,
-    /// A closed triangle mesh to remesh (.obj, .stl, .ply, .off). Without --bounds the grid covers
-    /// its bounding box padded by two cells, --res cells along the longest side.
+    /// A triangle mesh to remesh (.obj, .stl, .ply, .off); holes are spanned (generalised winding
+    /// number). Without --bounds the grid covers its bounding box padded by two cells, --res cells
+    /// along the longest side.
     #[arg(long, value_name = "FILE")]
     mesh: Option<PathBuf>,
-    /// An oriented point cloud to reconstruct a surface from (.ply with nx ny nz, or .xyz text
-    /// `x y z nx ny nz`); bounds as for --mesh.
+    /// An oriented point cloud to reconstruct a surface from (.ply with nx ny nz, .xyz text
+    /// `x y z nx ny nz`, or CGAL's .pwn); normals that disagree with their neighbours are turned
+    /// first; bounds as for --mesh.
     #[arg(long, value_name = "FILE")]
     points: Option<PathBuf>,
     /// A raw volume: samples without a header, little-endian, x fastest (needs --dims).

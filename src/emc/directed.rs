@@ -13,7 +13,7 @@
 //! (a sheet thinner than a cell) is already invisible to MC's signs, and stays so.
 
 use super::edges::{EdgeSampler, FieldRoots};
-use super::mesh_source::{grid_values, MeshBvh, MeshRays};
+use super::mesh_source::{check_encloses, grid_values, MeshBvh, MeshRays};
 use super::{mesh_with_sampler, EmcMesh, EmcOptions, EmcTimings};
 use crate::error::Error;
 use crate::field::{sample_grid, Field};
@@ -77,6 +77,7 @@ impl DirectedGrid {
     pub fn from_mesh(mesh: &Mesh, grid: &Grid) -> Result<DirectedGrid, Error> {
         let source = MeshBvh::new(mesh)?;
         let values = grid_values(&source, grid);
+        check_encloses(&source, &values)?;
         DirectedGrid::sample(&values, grid, 0.0, &MeshRays { mesh: &source, directed: true })
     }
 

@@ -3,6 +3,12 @@
 //! meets a triangle, and its normal is that triangle's, so sharp edges and corners of the input
 //! come back as feature lines and corners of the output.
 //!
+//! For a mesh with holes or a border ([`open_edges`]) the votes below are not defined (a line
+//! through a hole counts one crossing too few from there on), and inside is where the generalised
+//! winding number ([`super::winding`]) exceeds 1/2 instead: the holes are closed by a surface
+//! spanning their rims, with crossings interpolated where a grid edge passes through a hole. A
+//! mesh that bounds nothing (a sheet) is refused ([`check_encloses`]).
+//!
 //! Three queries over one [`MeshBvh`] (a bounding volume hierarchy over the triangles):
 //! - **inside or outside** at every grid point: the winding number of the mesh around the point,
 //!   counted along the grid line through it in each of the three axis directions (the signed
@@ -22,6 +28,7 @@
 //! So a ray through an edge or vertex of a closed mesh counts one crossing, never zero or two.
 
 use super::edges::EdgeSampler;
+use super::winding::WindingTree;
 use super::{mesh_with_sampler, EmcMesh, EmcOptions, EmcTimings};
 use crate::error::Error;
 use crate::grid::Grid;
@@ -29,6 +36,7 @@ use crate::mc::ms_since;
 use crate::mesh::analysis::bvh::{Aabb, Bvh};
 use crate::mesh::Mesh;
 use glam::{DVec2, Vec3};
+use std::collections::HashMap;
 use web_time::Instant;
 
 /// A triangle's corners as bits, turned so the smallest comes first: the same key for the same
@@ -55,6 +63,10 @@ pub struct MeshBvh {
     pub duplicates: usize,
     /// Whether the input was inside out (negative enclosed volume) and was turned around.
     pub flipped: bool,
+    /// Edges of the input used by an odd number of triangles ([`open_edges`]): the edges of its
+    /// holes or border. Where there are any, inside is decided by the generalised winding number.
+    pub open_edges: usize,
+    winding: Option<WindingTree>,
 }
 
 impl MeshBvh {
@@ -88,7 +100,17 @@ impl MeshBvh {
                 continue;
             }
             triangles.push([a, b, c]);
-            volume += a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3()));
+        }
+        // Six times the enclosed volume, about the middle of the box so that it means something
+        // for an open mesh too (a closed one's is the same about any point).
+        let (lo, hi) = triangles
+            .iter()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let middle = ((lo + hi) * 0.5).as_dvec3();
+        for [a, b, c] in &triangles {
+            let (a, b, c) = (a.as_dvec3() - middle, b.as_dvec3() - middle, c.as_dvec3() - middle);
+            volume += a.dot(b.cross(c));
         }
         if triangles.is_empty() {
             return Err(Error::InvalidOption(format!(
@@ -96,6 +118,7 @@ impl MeshBvh {
                 degenerate
             )));
         }
+        let open_edges = open_edges(mesh).len();
         let flipped = volume < 0.0;
         if flipped {
             for t in &mut triangles {
@@ -106,7 +129,8 @@ impl MeshBvh {
             triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bvh = Bvh::build(&boxes);
-        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped })
+        let winding = (open_edges > 0).then(|| WindingTree::new(&triangles));
+        Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped, open_edges, winding })
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -227,6 +251,43 @@ impl MeshBvh {
     }
 }
 
+/// The open edges of a triangle mesh, as pairs of corner positions: edges used by an odd number of
+/// its triangles (repeats of a triangle, the same [`cyclic_key`], counted once). Corners are
+/// matched by their coordinates, so a mesh whose faces do not share vertices (as in STL, or an
+/// exporter that splits vertices at seams) counts as closed where it is.
+///
+/// Around a closed surface (any number of shells, overlapping or not, non-manifold edges
+/// included) every edge has an even number of triangles, and a line crossing it changes its
+/// winding number only where it crosses the surface; at an edge of a hole the winding number
+/// jumps in mid-air, so inside and outside are not defined. Triangles without area stay in the
+/// count (a zero-area sliver in a closed mesh closes it as much as any other triangle; one
+/// repeating a corner uses its edge twice). Faces wound against their neighbours leave edges used
+/// twice the same way: those are not open, and the votes of the three axes (module documentation)
+/// decide around them as before.
+fn open_edges(mesh: &Mesh) -> Vec<(Vec3, Vec3)> {
+    let key = |p: Vec3| (p + Vec3::ZERO).to_array().map(f32::to_bits);
+    let mut uses: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::with_capacity(mesh.triangles.len() * 2);
+    let mut counted = std::collections::HashSet::with_capacity(mesh.triangles.len());
+    for t in 0..mesh.triangles.len() {
+        let corners = mesh.corners(t);
+        let area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length_squared() > 0.0;
+        if area && !counted.insert(cyclic_key(corners)) {
+            continue;
+        }
+        for k in 0..3 {
+            let (a, b) = (key(corners[k]), key(corners[(k + 1) % 3]));
+            if a != b {
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+    }
+    let mut open: Vec<([u32; 3], [u32; 3])> =
+        uses.into_iter().filter(|e| e.1 % 2 == 1).map(|e| e.0).collect();
+    open.sort_unstable();
+    let position = |bits: [u32; 3]| Vec3::from(bits.map(f32::from_bits));
+    open.into_iter().map(|(a, b)| (position(a), position(b))).collect()
+}
+
 /// The axis `d` runs along, when its other two components are exactly zero.
 fn axis_of(d: Vec3) -> Option<usize> {
     let nonzero = d.cmpne(Vec3::ZERO).bitmask();
@@ -328,14 +389,22 @@ fn closest_point_on_triangle(p: Vec3, [a, b, c]: &[Vec3; 3]) -> Vec3 {
     *a + ab * (vb / sum) + ac * (vc / sum)
 }
 
-/// Signed values at the grid points: negative inside (by [`MeshBvh::inside_votes`], two of three),
+/// Signed values at the grid points: negative inside (by [`MeshBvh::inside_votes`], two of three;
+/// for a mesh with holes, where the generalised winding number exceeds 1/2),
 /// positive outside. What matters for EMC is the sign; the magnitude is the distance to the
 /// nearest triangle at every point with a neighbour of the other sign (the only values Marching
 /// Cubes interpolates, and those are within a cell of the surface), and two cells elsewhere. An
 /// inside point on the surface gets the smallest negative float, so its sign survives.
 pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
-    let votes = mesh.inside_votes(grid);
-    let inside: Vec<bool> = votes.iter().map(|&v| v >= 2).collect();
+    let inside: Vec<bool> = match &mesh.winding {
+        Some(tree) => (0..grid.point_count())
+            .map(|n| {
+                let [i, j, k] = grid.unindex(n);
+                tree.winding(grid.position(i, j, k)) > 0.5
+            })
+            .collect(),
+        None => mesh.inside_votes(grid).iter().map(|&v| v >= 2).collect(),
+    };
     let band = 2.0 * grid.cell_size();
     let pts = grid.points();
     let mut values = vec![0.0f32; grid.point_count()];
@@ -365,6 +434,22 @@ pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
         }
     }
     values
+}
+
+/// Refuses the grid values of a mesh with holes where no grid point is inside: an open surface
+/// that bounds nothing (a sheet, a lone face) has a winding number below 1/2 everywhere, and an
+/// empty output would say nothing about why. A closed mesh whose solid falls between the grid
+/// points meshes to nothing as any surface smaller than a cell does.
+pub fn check_encloses(mesh: &MeshBvh, values: &[f32]) -> Result<(), Error> {
+    if mesh.open_edges > 0 && !values.iter().any(|&v| v < 0.0) {
+        return Err(Error::InvalidOption(format!(
+            "the mesh has {} open edges (holes or a border) and encloses nothing: its generalised \
+             winding number is below 1/2 at every grid point, so it is a sheet rather than the \
+             surface of a solid",
+            mesh.open_edges
+        )));
+    }
+    Ok(())
 }
 
 /// EMC's edge crossings on a triangle mesh: the first ray hit along the edge and the hit
@@ -416,6 +501,7 @@ pub fn remesh(mesh: &Mesh, grid: &Grid, options: &EmcOptions) -> Result<(EmcMesh
     let t0 = Instant::now();
     let source = MeshBvh::new(mesh)?;
     let values = grid_values(&source, grid);
+    check_encloses(&source, &values)?;
     let sample_ms = ms_since(t0);
     let sampler = MeshRays { mesh: &source, directed: options.directed };
     let (mut out, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;
@@ -542,6 +628,53 @@ mod tests {
             3,
             "the centre, on lines through the vertices"
         );
+    }
+
+    #[test]
+    fn open_edges_are_counted_by_position() {
+        let m = cube();
+        // Every face's vertices split apart (as an STL would have them): still closed.
+        let mut split = Mesh::default();
+        for t in 0..m.triangles.len() {
+            let base = split.positions.len() as u32;
+            split.positions.extend(m.corners(t));
+            split.triangles.push([base, base + 1, base + 2]);
+        }
+        assert!(open_edges(&split).is_empty());
+        // A zero-area triangle repeating a corner and a repeated triangle change nothing.
+        let mut extra = m.clone();
+        extra.triangles.push([0, 0, 1]);
+        extra.triangles.push(m.triangles[3]);
+        assert!(open_edges(&extra).is_empty());
+        // One triangle missing: its three edges are open.
+        let mut holed = m.clone();
+        holed.triangles.remove(5);
+        assert_eq!(open_edges(&holed).len(), 3);
+        assert_eq!(MeshBvh::new(&holed).unwrap().open_edges, 3);
+        assert_eq!(MeshBvh::new(&m).unwrap().open_edges, 0);
+        // A face wound the wrong way round is not a hole.
+        let mut misturned = m.clone();
+        misturned.triangles[5].swap(1, 2);
+        assert!(open_edges(&misturned).is_empty());
+        // A triangle [0, 0, 1] uses its edge twice; alone it would be open once the cube's face
+        // next to it is gone.
+        let mut sliver = holed.clone();
+        sliver.triangles.push([0, 0, 1]);
+        assert_eq!(open_edges(&sliver).len(), 3);
+    }
+
+    #[test]
+    fn sheets_are_refused() {
+        let square = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            normals: vec![],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        let source = MeshBvh::new(&square).unwrap();
+        assert_eq!(source.open_edges, 4);
+        let grid = padded_grid(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), 12).unwrap();
+        let err = check_encloses(&source, &grid_values(&source, &grid)).unwrap_err().to_string();
+        assert!(err.contains("4 open edges") && err.contains("encloses nothing"), "{err}");
     }
 
     #[test]

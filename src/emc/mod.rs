@@ -18,11 +18,13 @@ pub mod lines;
 pub mod merge;
 pub mod mesh_source;
 pub mod nearby;
+pub mod orient;
 pub mod placement;
 mod plan;
 pub mod point_source;
 pub mod resample;
 pub mod untangle;
+pub mod winding;
 
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};

@@ -27,6 +27,8 @@ pub struct PointIndex {
     normals: Vec<Vec3>,
     /// Per element: the split axis when it is the middle of an inner node's range.
     axes: Vec<u8>,
+    /// Per element: its index in the cloud the index was built from.
+    order: Vec<u32>,
 }
 
 impl PointIndex {
@@ -40,6 +42,7 @@ impl PointIndex {
             positions: order.iter().map(|&i| cloud.positions[i as usize]).collect(),
             normals: order.iter().map(|&i| cloud.normals[i as usize]).collect(),
             axes,
+            order,
         })
     }
 
@@ -49,6 +52,11 @@ impl PointIndex {
 
     pub fn is_empty(&self) -> bool {
         self.positions.is_empty()
+    }
+
+    /// The index in the indexed cloud of (reordered) sample `i`.
+    pub fn original(&self, i: u32) -> usize {
+        self.order[i as usize] as usize
     }
 
     /// Position and unit normal of (reordered) sample `i`.
@@ -212,12 +220,24 @@ const BESIDE: f32 = 0.5;
 /// spurious bubble). So where `p` lies beside its nearest element rather than in front of or
 /// behind it (`|n·(p − q)| < |p − q| / 2`), the element among the 8 nearest that `p` faces most
 /// squarely (largest `|n·(p − q)| / |p − q|`) gives the value instead.
+///
+/// A surface the samples cover lies within their bounding box, so a grid point more than a cell
+/// outside the box is outside whatever its nearest plane says: the value is at least the distance
+/// to the box less a cell. Otherwise the tangent plane of a sample on a thin part, or at a sharp
+/// edge seen from beyond it, can reach out to the grid's border and call points there inside,
+/// and the surface would be cut open by the border. With the default grid (the box padded by two
+/// cells) every border point is outside, so the output is closed.
 pub fn grid_values(points: &PointIndex, grid: &Grid) -> Vec<f32> {
     let [nx, ny, nz] = grid.points();
     let mut values = vec![0.0f32; grid.point_count()];
     let mut guess = None;
     let mut neighbours = Vec::with_capacity(NEIGHBOURS);
     let band = 2.0 * grid.cell_size();
+    let (lo, hi) = points
+        .positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let outside_box = |p: Vec3| (lo - p).max(p - hi).max(Vec3::ZERO).length() - grid.cell_size();
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
@@ -235,7 +255,7 @@ pub fn grid_values(points: &PointIndex, grid: &Grid) -> Vec<f32> {
                         value = points.plane_distance(best.1, p);
                     }
                 }
-                values[grid.index(i, j, k)] = value;
+                values[grid.index(i, j, k)] = value.max(outside_box(p));
             }
         }
     }

@@ -6,7 +6,8 @@
 //! - meshes: Wavefront OBJ (`v` and `f`; polygons fan-triangulated; negative indices), STL (binary
 //!   and ASCII; identical corners are welded into shared vertices), PLY (ASCII, binary little- and
 //!   big-endian; `vertex` x y z and a `face` list), OFF (and its COFF/NOFF variants);
-//! - point clouds: PLY whose vertices carry `nx ny nz`, and XYZ text (`x y z nx ny nz` per line).
+//! - point clouds: PLY whose vertices carry `nx ny nz`, and XYZ text (`x y z nx ny nz` per line)
+//!   or CGAL's PWN (the same text, optionally after a line holding the number of points).
 //!
 //! Malformed input is an [`Error::Io`] naming the format and the line (text) or the element and
 //! byte offset (binary); an unknown format name is an [`Error::InvalidOption`]. No input makes a
@@ -110,7 +111,7 @@ fn unit_normal(n: Vec3) -> Option<Vec3> {
 /// Mesh formats [`read_mesh`] understands, by the names (file extensions) it accepts as hints.
 pub const MESH_FORMATS: [&str; 4] = ["obj", "stl", "ply", "off"];
 /// Point cloud formats [`read_points`] understands.
-pub const POINT_FORMATS: [&str; 2] = ["ply", "xyz"];
+pub const POINT_FORMATS: [&str; 3] = ["ply", "xyz", "pwn"];
 
 /// Reads a triangle mesh. `format_hint` is a format name or a file name whose extension names one
 /// (`"stl"`, `".PLY"`, `"part.obj"`); without it the format is recognised from the content (PLY by
@@ -140,15 +141,17 @@ pub fn read_mesh(bytes: &[u8], format_hint: Option<&str>) -> Result<Mesh, Error>
     Ok(mesh)
 }
 
-/// Reads an oriented point cloud: a PLY file whose vertices have `nx ny nz`, or XYZ text with
-/// `x y z nx ny nz` on each line (spaces, tabs or commas between; `#` starts a comment; further
-/// columns such as colours are ignored). Normals are scaled to unit length. `format_hint` works as
-/// in [`read_mesh`] (`"xyz"`, `"pts"` and `"txt"` all mean XYZ text); without it, files starting
-/// with `ply` are PLY and everything else is XYZ.
+/// Reads an oriented point cloud: a PLY file whose vertices have `nx ny nz`, or text with
+/// `x y z nx ny nz` on each line (XYZ, or CGAL's PWN, which may start with a line holding the
+/// number of points; spaces, tabs or commas between; `#` starts a comment; further columns such as
+/// colours are ignored). Normals are scaled to unit length. `format_hint` works as in
+/// [`read_mesh`] (`"xyz"`, `"pts"` and `"txt"` all mean XYZ text, `"pwn"` PWN); without it, files
+/// starting with `ply` are PLY and everything else is point text.
 pub fn read_points(bytes: &[u8], format_hint: Option<&str>) -> Result<PointCloud, Error> {
     let format = match format_hint {
-        Some(hint) => match format_name(hint, &["ply", "xyz", "pts", "txt"], "point cloud")? {
+        Some(hint) => match format_name(hint, &["ply", "xyz", "pwn", "pts", "txt"], "point cloud")? {
             "ply" => "ply",
+            "pwn" => "pwn",
             _ => "xyz",
         },
         None if bytes.starts_with(b"ply") => "ply",
@@ -156,7 +159,8 @@ pub fn read_points(bytes: &[u8], format_hint: Option<&str>) -> Result<PointCloud
     };
     let cloud = match format {
         "ply" => ply::read(bytes)?.into_points()?,
-        _ => xyz::read(bytes)?,
+        "pwn" => xyz::read(bytes, "PWN")?,
+        _ => xyz::read(bytes, "XYZ")?,
     };
     if cloud.is_empty() {
         return Err(Error::Io(format!("{} file has no points", format.to_uppercase())));
@@ -259,6 +263,7 @@ mod tests {
         assert_eq!(format_name("OBJ", &MESH_FORMATS, "mesh").unwrap(), "obj");
         assert_eq!(format_name(".stl", &MESH_FORMATS, "mesh").unwrap(), "stl");
         assert_eq!(format_name("dir.v2/part.Ply", &MESH_FORMATS, "mesh").unwrap(), "ply");
+        assert_eq!(format_name("scans/ball.PWN", &POINT_FORMATS, "point cloud").unwrap(), "pwn");
         let err = format_name("gltf", &MESH_FORMATS, "mesh").unwrap_err();
         assert!(
             matches!(&err, Error::InvalidOption(m) if m.contains("'gltf'") && m.contains("off")),

@@ -10,6 +10,7 @@
 
 use super::{dmc_on_samples, sampled_res, Meshed, Method, Output, Request};
 use crate::emc::mesh_source::{self, mesh_bounds, padded_grid, MeshBvh};
+use crate::emc::orient;
 use crate::emc::point_source::{self, PointIndex};
 use crate::error::Error;
 use crate::field::{Field, SampleGradient, SampledField};
@@ -70,8 +71,9 @@ fn iso_must_be_zero(request: &Request, what: &str) -> Result<(), Error> {
     Ok(())
 }
 
-/// Remeshes a closed triangle mesh (counter-clockwise seen from outside, or consistently the
-/// other way round, which is detected and turned around).
+/// Remeshes a triangle mesh (counter-clockwise seen from outside, or consistently the other way
+/// round, which is detected and turned around). A mesh with holes is meshed by its generalised
+/// winding number, which spans them; one that bounds nothing (a sheet) is refused.
 pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
     iso_must_be_zero(request, "remeshing a triangle mesh (the surface is the mesh)")?;
     let bounds = mesh_bounds(mesh);
@@ -85,6 +87,7 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
         _ => {
             let t0 = web_time::Instant::now();
             let values = mesh_source::grid_values(&source, &grid);
+            mesh_source::check_encloses(&source, &values)?;
             mesh_signed_values(&values, &grid, request, mc::ms_since(t0))?
         }
     };
@@ -92,12 +95,15 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
     meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis)
 }
 
-/// Reconstructs the surface an oriented point cloud samples (normals pointing out of the solid;
-/// they are scaled to unit length here).
+/// Reconstructs the surface an oriented point cloud samples. Normals should point out of the
+/// solid; they are scaled to unit length here, and the few that disagree with their neighbours (or
+/// all of them, in a cloud exported inside out) are turned around first
+/// ([`orient::orient_normals`]); a cloud whose normals have no prevailing orientation is refused.
 pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Error> {
     iso_must_be_zero(request, "reconstructing from points (the surface is the samples' tangent planes)")?;
-    let cloud = cloud.clone().normalized()?;
+    let mut cloud = cloud.clone().normalized()?;
     cloud.validate()?;
+    orient::orient_normals(&mut cloud)?;
     let grid = input_grid(cloud.bounds(), request)?;
     let index = PointIndex::new(&cloud)?;
     let meshed = match request.method {
