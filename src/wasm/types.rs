@@ -152,9 +152,11 @@ export interface MeshStats {
 /**
  * Inputs that are not fields (EMC's remeshing and reconstruction applications), as typed arrays:
  * - meshTriangles(positions: Float32Array, indices: Uint32Array, options?: MeshOptions): remesh a
- *   closed triangle mesh (xyz triples; vertex-index triples, counter-clockwise from outside);
+ *   triangle mesh (xyz triples; vertex-index triples, counter-clockwise from outside); holes are
+ *   spanned by the generalised winding number, a sheet that encloses nothing is refused;
  * - meshPoints(positions: Float32Array, normals: Float32Array, options?: MeshOptions): reconstruct
- *   the surface sampled by points with outward normals (xyz triples each).
+ *   the surface sampled by points with outward normals (xyz triples each); normals that disagree
+ *   with their neighbours are turned back first, a cloud whose normals are not oriented is refused.
  * Use method "emc" for sharp edges and corners; "mc" (default) is plain Marching Cubes on the same
  * grid. iso must be 0. Stats measure against the input (distance to the mesh, or to the nearest
  * sample's tangent plane).
