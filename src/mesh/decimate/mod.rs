@@ -311,7 +311,9 @@ impl<'a> State<'a> {
                 self.area[v as usize] += area / 3.0;
             }
         }
-        let edges: Vec<(u32, u32)> = self.lines.keys().copied().collect();
+        // Sorted: sums in a fixed order make the same input give the same output, run after run.
+        let mut edges: Vec<(u32, u32)> = self.lines.keys().copied().collect();
+        edges.sort_unstable();
         for (a, b) in edges {
             let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
             let along = pb - pa;
