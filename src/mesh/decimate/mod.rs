@@ -22,6 +22,7 @@
 //! the analysis's exact triangle-pair test), and with a field, no new vertex or face sample
 //! farther than [`DecimateOptions::max_error`] from the zero set.
 
+mod flip;
 mod quadric;
 mod spatial;
 
@@ -97,6 +98,7 @@ pub fn decimate(
 ) -> Decimated {
     let mut state = State::new(mesh, feature_edges, field, options);
     state.run();
+    state.improve_angles();
     state.finish(mesh)
 }
 
@@ -467,17 +469,26 @@ impl<'a> State<'a> {
         if !self.within_error(p, &new_corners) {
             return None;
         }
-        let changed_ids: Vec<u32> = changed.iter().map(|c| c.0).collect();
+        if self.crosses(&changed, &new_corners, &removed) {
+            return None;
+        }
+        Some(Plan { removed, changed, line })
+    }
+
+    /// Whether any of the rewritten faces `changed` (at `corners`) crosses another of them or a
+    /// face nearby; faces in `removed` are about to go and do not count.
+    fn crosses(&mut self, changed: &[(u32, [u32; 3])], corners: &[[DVec3; 3]], removed: &[u32]) -> bool {
         for i in 0..changed.len() {
             for j in i + 1..changed.len() {
-                if indexed_pair_intersects((changed[i].1, new_corners[i]), (changed[j].1, new_corners[j])) {
-                    return None;
+                if indexed_pair_intersects((changed[i].1, corners[i]), (changed[j].1, corners[j])) {
+                    return true;
                 }
             }
         }
+        let changed_ids: Vec<u32> = changed.iter().map(|c| c.0).collect();
         let mut nearby = Vec::new();
         for (i, &(_, t)) in changed.iter().enumerate() {
-            let (lo, hi) = bounds(&new_corners[i]);
+            let (lo, hi) = bounds(&corners[i]);
             nearby.clear();
             self.grid.query(lo, hi, &mut nearby);
             for &g in &nearby {
@@ -489,12 +500,12 @@ impl<'a> State<'a> {
                 if glo.cmpgt(hi).any() || ghi.cmplt(lo).any() {
                     continue;
                 }
-                if indexed_pair_intersects((t, new_corners[i]), (self.tris[g as usize], c)) {
-                    return None;
+                if indexed_pair_intersects((t, corners[i]), (self.tris[g as usize], c)) {
+                    return true;
                 }
             }
         }
-        Some(Plan { removed, changed, line })
+        false
     }
 
     /// Around the kept vertex, each neighbour must be reached by exactly one face edge out and one
