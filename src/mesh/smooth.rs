@@ -161,7 +161,7 @@ fn project(field: &dyn Field, mut p: Vec3, step: f32) -> Vec3 {
     for _ in 0..2 {
         let g = field.gradient(p).unwrap_or_else(|| finite_difference_gradient(field, p, step));
         let g2 = g.length_squared();
-        if !(g2 > 1e-12) {
+        if g2.is_nan() || g2 <= 1e-12 {
             break;
         }
         let q = p - field.value(p) * g / g2;

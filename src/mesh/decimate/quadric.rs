@@ -45,7 +45,8 @@ impl Quadric {
     pub fn minimizer(&self) -> Option<DVec3> {
         let det = self.a.determinant();
         let scale = self.a.x_axis.length() + self.a.y_axis.length() + self.a.z_axis.length();
-        if !(det.abs() > 1e-9 * scale * scale * scale) {
+        // Written so that a NaN determinant also counts as singular.
+        if det.abs().partial_cmp(&(1e-9 * scale * scale * scale)) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let p = self.a.inverse() * -self.b;
