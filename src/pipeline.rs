@@ -288,7 +288,6 @@ impl Meshed {
     /// projects smoothed vertices, `cell` sets the scale of the tolerances.
     fn refine(mut self, request: &Request, truth: &dyn Field, cell: f32) -> Result<Meshed, Error> {
         if let Some(target) = request.decimate {
-            crate::progress::checkpoint("decimate", 0.0)?;
             let t0 = web_time::Instant::now();
             let options = DecimateOptions {
                 target_triangles: target,
@@ -297,15 +296,14 @@ impl Meshed {
                 feature_tolerance: 0.008 * cell as f64,
                 ..DecimateOptions::default()
             };
-            let out = decimate(&self.mesh, &self.feature_edges, Some(truth), &options);
+            let out = decimate(&self.mesh, &self.feature_edges, Some(truth), &options)?;
             self.mesh = out.mesh;
             self.feature_edges = out.feature_edges;
             self.phases.push(("decimate".into(), mc::ms_since(t0)));
         }
         if request.smooth > 0 {
-            crate::progress::checkpoint("smooth", 0.0)?;
             let t0 = web_time::Instant::now();
-            smooth(&mut self.mesh, &self.feature_edges, Some(truth), request.smooth);
+            smooth(&mut self.mesh, &self.feature_edges, Some(truth), request.smooth)?;
             self.phases.push(("smooth".into(), mc::ms_since(t0)));
         }
         Ok(self)

@@ -11,8 +11,10 @@
 //! halfway to each corner) farther from the surface than the farthest was before smoothing: next to
 //! a crease, a relaxed and projected vertex can land on the other sheet.
 
+use crate::error::Error;
 use crate::field::{finite_difference_gradient, Field};
 use crate::mesh::Mesh;
+use crate::progress::checkpoint;
 use glam::Vec3;
 use std::collections::{BTreeSet, HashMap};
 
@@ -22,7 +24,13 @@ const MU: f32 = -0.53;
 
 /// Smooths `mesh` in place by `passes` passes, leaving the endpoints of `feature_edges` and the
 /// vertices on open or non-manifold edges where they are.
-pub fn smooth(mesh: &mut Mesh, feature_edges: &[[u32; 2]], field: Option<&dyn Field>, passes: usize) {
+/// Fails only with [`Error::Cancelled`], from a [`checkpoint`] ("smooth") before each pass.
+pub fn smooth(
+    mesh: &mut Mesh,
+    feature_edges: &[[u32; 2]],
+    field: Option<&dyn Field>,
+    passes: usize,
+) -> Result<(), Error> {
     let n = mesh.positions.len();
     let mut fixed = vec![false; n];
     for &[a, b] in feature_edges {
@@ -68,7 +76,8 @@ pub fn smooth(mesh: &mut Mesh, feature_edges: &[[u32; 2]], field: Option<&dyn Fi
         _ => false,
     };
     let mut moved = vec![false; n];
-    for _ in 0..passes {
+    for pass in 0..passes {
+        checkpoint("smooth", pass as f32 / passes as f32)?;
         for weight in [LAMBDA, MU] {
             let before = mesh.positions.clone();
             for v in 0..n {
@@ -120,6 +129,7 @@ pub fn smooth(mesh: &mut Mesh, feature_edges: &[[u32; 2]], field: Option<&dyn Fi
             mesh.normals[v] = from_field.unwrap_or(faces.normals[v]);
         }
     }
+    Ok(())
 }
 
 /// Whether face `f` now points more than 60° away from where it pointed at `before`, or lost its

@@ -26,9 +26,11 @@ mod flip;
 mod quadric;
 mod spatial;
 
+use crate::error::Error;
 use crate::field::{finite_difference_gradient, Field};
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use crate::mesh::Mesh;
+use crate::progress::checkpoint;
 use glam::{DVec3, Vec3};
 use quadric::Quadric;
 use spatial::SpatialGrid;
@@ -89,18 +91,22 @@ fn key(a: u32, b: u32) -> (u32, u32) {
 
 /// Decimates `mesh` towards `options.target_triangles`, keeping `feature_edges` (vertex index
 /// pairs) as constraints; `field`, where given, bounds the error and gives moved vertices their
-/// normals.
+/// normals. Fails only with [`Error::Cancelled`], from a [`checkpoint`] ("decimate") every few
+/// thousand collapses: on a large mesh this takes seconds, and a page must be able to stop it.
 pub fn decimate(
     mesh: &Mesh,
     feature_edges: &[[u32; 2]],
     field: Option<&dyn Field>,
     options: &DecimateOptions,
-) -> Decimated {
+) -> Result<Decimated, Error> {
     let mut state = State::new(mesh, feature_edges, field, options);
-    state.run();
+    state.run()?;
     state.improve_angles();
-    state.finish(mesh)
+    Ok(state.finish(mesh))
 }
+
+/// Heap entries looked at between two checkpoints.
+const POPS_PER_CHECKPOINT: usize = 4096;
 
 /// A heap entry: collapse `remove` into `keep`, moving `keep` to `target`; stale once either
 /// vertex's stamp has moved on.
@@ -408,9 +414,16 @@ impl<'a> State<'a> {
         q.eval(target) / area + 1e-5 * length
     }
 
-    fn run(&mut self) {
+    fn run(&mut self) -> Result<(), Error> {
+        let start = self.alive_count;
+        let span = start.saturating_sub(self.options.target_triangles).max(1) as f32;
+        let mut pops = 0usize;
         while self.alive_count > self.options.target_triangles {
             let Some(c) = self.heap.pop() else { break };
+            pops += 1;
+            if pops % POPS_PER_CHECKPOINT == 0 {
+                checkpoint("decimate", (start - self.alive_count) as f32 / span)?;
+            }
             let (r, k) = (c.remove as usize, c.keep as usize);
             if self.faces_of[r].is_empty() || c.stamps != [self.stamp[r], self.stamp[k]] {
                 continue;
@@ -424,6 +437,7 @@ impl<'a> State<'a> {
                 self.apply(c.remove, c.keep, c.target, plan);
             }
         }
+        Ok(())
     }
 
     /// Everything a collapse must pass (see the module doc); the faces it rewrites if it does.

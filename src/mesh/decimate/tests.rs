@@ -11,7 +11,7 @@ fn a_box_comes_down_to_its_corners_with_its_edges_in_place() {
     let out = emc("box(0.5, 0.6, 0.7)", 16);
     let before = topology(&out.mesh);
     let options = DecimateOptions { feature_tolerance: 1e-4, ..DecimateOptions::default() };
-    let d = decimate(&out.mesh, &out.feature_edges, None, &options);
+    let d = decimate(&out.mesh, &out.feature_edges, None, &options).unwrap();
     let after = topology(&d.mesh);
     assert!(after.is_closed_manifold() && after.euler == before.euler, "{after:?}");
     assert_eq!(self_intersections(&d.mesh), 0);
@@ -37,7 +37,7 @@ fn the_error_bound_stops_a_sphere_before_it_turns_polyhedral() {
     let undecimated = crate::mesh::analysis::surface_error(&out.mesh, &field).dist_max;
     let bound = 2.0 * undecimated;
     let options = DecimateOptions { max_error: Some(bound), ..DecimateOptions::default() };
-    let d = decimate(&out.mesh, &out.feature_edges, Some(&field), &options);
+    let d = decimate(&out.mesh, &out.feature_edges, Some(&field), &options).unwrap();
     let error = crate::mesh::analysis::surface_error(&d.mesh, &field);
     assert!(error.dist_max <= bound * 1.01, "{error:?} against {undecimated}");
     assert!(d.mesh.triangle_count() * 2 < out.mesh.triangle_count());
