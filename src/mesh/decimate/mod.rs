@@ -18,7 +18,7 @@
 //! edge orientations (the mesh stays a closed oriented 2-manifold of the same Euler
 //! characteristic), no face turned by more than [`DecimateOptions::max_normal_turn_deg`], no
 //! degenerate faces, no new angle below [`DecimateOptions::min_angle_deg`] unless the faces it
-//! replaces were already worse, no crossing with any face nearby (a [`spatial::SpatialGrid`] and
+//! replaces were already worse, no crossing with any face nearby (a hash grid of the faces and
 //! the analysis's exact triangle-pair test), and with a field, no new vertex or face sample
 //! farther than [`DecimateOptions::max_error`] from the zero set.
 
@@ -43,7 +43,7 @@ pub struct DecimateOptions {
     /// Stop once at most this many triangles are left (or no collapse passes the checks).
     pub target_triangles: usize,
     /// Refuse a collapse that puts a vertex or a face sample (centroid, and halfway from it to each
-    /// corner: what [`crate::mesh::analysis::surface_error`] measures) farther than this from the
+    /// corner: what [`crate::mesh::analysis::surface_error()`] measures) farther than this from the
     /// field's zero set. Without a field, bounds the quadric's RMS distance instead.
     pub max_error: Option<f64>,
     /// How far an original feature-line vertex may end up from the decimated feature polyline.
