@@ -71,7 +71,10 @@ impl State<'_> {
             return false;
         }
         let changed = [(f1, [a, d, c]), (f2, [d, b, c])];
-        if !self.within_error(p(c), &new) || self.crosses(&changed, &new, &[]) {
+        // A flip moves no vertex: it may not leave the bound, or where the old pair was already
+        // outside it (a sliver along a curved crease), not get farther.
+        let allowed = self.within_error(p(c), &new) || self.face_distance(&new) <= self.face_distance(&old);
+        if !allowed || self.crosses(&changed, &new, &[]) {
             return false;
         }
         self.tris[f1 as usize] = changed[0].1;

@@ -569,28 +569,41 @@ impl<'a> State<'a> {
     }
 
     /// With a field: the new vertex and the sample points of the new faces within
-    /// [`DecimateOptions::max_error`] of the zero set (one Newton step: `|f| / |∇f|`).
+    /// [`DecimateOptions::max_error`] of the zero set.
     fn within_error(&self, p: DVec3, faces: &[[DVec3; 3]]) -> bool {
-        let (Some(field), Some(bound)) = (self.field, self.options.max_error) else { return true };
-        let distance = |x: DVec3| {
-            let x = x.as_vec3();
-            let value = field.value(x);
-            let gradient =
-                field.gradient(x).unwrap_or_else(|| finite_difference_gradient(field, x, self.fd_step));
-            let g = gradient.length();
-            if g > 1e-12 {
-                (value / g).abs() as f64
-            } else {
-                f64::INFINITY
-            }
-        };
-        if distance(p) > bound {
-            return false;
-        }
-        faces.iter().all(|c| {
+        let Some(bound) = self.options.max_error else { return true };
+        self.field.is_none() || (self.distance(p) <= bound && self.face_distance(faces) <= bound)
+    }
+
+    /// The largest distance estimate over the faces' samples: each centroid and the points halfway
+    /// from it to the corners, what [`crate::mesh::analysis::surface_error()`] measures inside a
+    /// face. 0 without a field.
+    fn face_distance(&self, faces: &[[DVec3; 3]]) -> f64 {
+        let mut worst = 0.0f64;
+        for c in faces {
             let centre = (c[0] + c[1] + c[2]) / 3.0;
-            distance(centre) <= bound && c.iter().all(|&corner| distance(0.5 * (centre + corner)) <= bound)
-        })
+            worst = worst.max(self.distance(centre));
+            for &corner in c {
+                worst = worst.max(self.distance(0.5 * (centre + corner)));
+            }
+        }
+        worst
+    }
+
+    /// One Newton step's estimate of the distance from `x` to the field's zero set, `|f| / |∇f|`
+    /// (exact for signed distances); 0 without a field.
+    fn distance(&self, x: DVec3) -> f64 {
+        let Some(field) = self.field else { return 0.0 };
+        let x = x.as_vec3();
+        let value = field.value(x);
+        let gradient =
+            field.gradient(x).unwrap_or_else(|| finite_difference_gradient(field, x, self.fd_step));
+        let g = gradient.length();
+        if g > 1e-12 {
+            (value / g).abs() as f64
+        } else {
+            f64::INFINITY
+        }
     }
 
     fn apply(&mut self, u: u32, v: u32, p: DVec3, plan: Plan) {
