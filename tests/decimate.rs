@@ -223,3 +223,36 @@ fn bad_decimate_and_smooth_values_are_refused_by_name() {
     assert!(err(Request { smooth: 1000, ..request(8) }).contains("smooth"));
     assert!(err(Request { method: Method::Quad, decimate: Some(10), ..request(8) }).contains("quad"));
 }
+
+/// The share of triangles with a corner under 10°.
+fn sliver_share(mesh: &isoforge::Mesh) -> f64 {
+    let slivers = (0..mesh.triangle_count())
+        .filter(|&t| {
+            let c = mesh.corners(t);
+            (0..3).any(|i| {
+                let (a, b) = (c[(i + 1) % 3] - c[i], c[(i + 2) % 3] - c[i]);
+                a.angle_between(b).to_degrees() < 10.0
+            })
+        })
+        .count();
+    slivers as f64 / mesh.triangle_count().max(1) as f64
+}
+
+/// The goal, fewer than 2 % of the triangles under 10° without moving a feature point,
+/// where EMC has 6.0 % (cube minus a ball, decimated: 0 %) and 15.8 % (rotated box: 1.3 %) at 64
+/// cells; the fandisk goes from 0.9 % to 2.0 %, its fixed feature vertices keeping their slivers
+/// as the rest thins out. Not the gear: its teeth's fans keep 9.6 % (docs/decimate.md).
+#[test]
+#[cfg_attr(target_arch = "wasm32", ignore)]
+fn decimation_to_a_tenth_leaves_few_slivers() {
+    for (name, most) in [("cube_minus_sphere", 0.02), ("rotated_box", 0.02), ("fandisk", 0.025)] {
+        let res = 64;
+        let input = pipeline::mesh_scene(name, &request(res)).unwrap();
+        let target = input.mesh.triangle_count() / 10;
+        let output = pipeline::mesh_scene(name, &Request { decimate: Some(target), ..request(res) }).unwrap();
+        let (before, after) = (sliver_share(&input.mesh), sliver_share(&output.mesh));
+        eprintln!("{name}: {:.1} % -> {:.1} % under 10°", 100.0 * before, 100.0 * after);
+        assert!(after < most, "{name}: {:.1} % of the triangles under 10°", 100.0 * after);
+        assert_kept(&input, &output, scene_cell(name, res), name);
+    }
+}
