@@ -7,7 +7,7 @@
 //! and Taubin's inflating μ step cancels the shrinking. With a field the relaxation becomes a
 //! tangential one: each moved vertex is pulled back onto the zero set, so the triangles even out
 //! while the distance error does not grow. A vertex stays where it was if its move would turn one
-//! of its faces by more than 60°, or (with a field) put a sample of one of its faces (centroid, and
+//! of its faces by more than 60°, give it a new sliver (see `turned`), or (with a field) put a sample of one of its faces (centroid, and
 //! halfway to each corner) farther from the surface than the farthest was before smoothing: next to
 //! a crease, a relaxed and projected vertex can land on the other sheet.
 
@@ -132,17 +132,30 @@ pub fn smooth(
     Ok(())
 }
 
-/// Whether face `f` now points more than 60° away from where it pointed at `before`, or lost its
-/// area.
+/// Whether face `f` now points more than 60° away from where it pointed at `before`, lost its
+/// area, or became a sliver: a corner under [`SLIVER_DEG`] and under its smallest before. Moving
+/// vertices among fixed feature vertices can squeeze a face that decimation had kept wide.
 fn turned(mesh: &Mesh, before: &[Vec3], f: usize) -> bool {
     let [a, b, c] = mesh.triangles[f].map(|v| v as usize);
     let old = (before[b] - before[a]).cross(before[c] - before[a]);
     let new = mesh.face_normal(f);
+    let squeezed = || {
+        let angle = min_angle(&mesh.corners(f));
+        angle < SLIVER_DEG.to_radians() && angle < min_angle(&[before[a], before[b], before[c]])
+    };
     match (old.try_normalize(), new.try_normalize()) {
-        (Some(o), Some(n)) => o.dot(n) < 0.5,
+        (Some(o), Some(n)) => o.dot(n) < 0.5 || squeezed(),
         (Some(_), None) => true,
         _ => false,
     }
+}
+
+/// A face may not get a corner under this unless it had a smaller one already.
+const SLIVER_DEG: f32 = 10.0;
+
+/// Smallest interior angle, in radians.
+fn min_angle(c: &[Vec3; 3]) -> f32 {
+    (0..3).map(|i| (c[(i + 1) % 3] - c[i]).angle_between(c[(i + 2) % 3] - c[i])).fold(f32::INFINITY, f32::min)
 }
 
 /// The largest one-step distance estimate `|f| / |∇f|` over face `f`'s centroid and the points
