@@ -256,3 +256,22 @@ fn decimation_to_a_tenth_leaves_few_slivers() {
         assert_kept(&input, &output, scene_cell(name, res), name);
     }
 }
+
+/// Every triangle method's mesh can be decimated (no feature lines: only the quadrics and the
+/// checks protect the creases): the topology and the absence of crossings hold for all.
+#[test]
+fn every_triangle_method_decimates_to_a_closed_manifold_without_crossings() {
+    for method in [Method::Mc, Method::Mcq, Method::Dmc, Method::Emc] {
+        let res = 32;
+        let input = pipeline::mesh_scene("cube_minus_sphere", &Request { method, ..request(res) }).unwrap();
+        let target = input.mesh.triangle_count() / 4;
+        let output = pipeline::mesh_scene(
+            "cube_minus_sphere",
+            &Request { method, decimate: Some(target), ..request(res) },
+        )
+        .unwrap();
+        let topo = assert_kept(&input, &output, scene_cell("cube_minus_sphere", res), method.name());
+        assert!(topo.is_closed_manifold(), "{method:?}: {topo:?}");
+        assert!(output.mesh.triangle_count() * 3 <= input.mesh.triangle_count(), "{method:?}");
+    }
+}
