@@ -11,6 +11,8 @@ use crate::field::{BatchFn, Field, SampleGradient, SampledField};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{self, McOptions, Topology};
 use crate::mcq::{self, McqOptions, PolygonRules};
+use crate::mesh::decimate::{decimate, DecimateOptions};
+use crate::mesh::smooth::smooth;
 use crate::mesh::Mesh;
 use crate::quad::{self, QuadOptions};
 use crate::scenes;
@@ -107,6 +109,15 @@ pub struct Request {
     pub max_depth: Option<u8>,
     /// DMC: QEF samples per cell along each axis.
     pub samples_per_cell: usize,
+    /// After meshing, decimate to at most this many triangles (see [`crate::mesh::decimate`]):
+    /// feature lines stay where they are, the mesh stays a closed manifold without crossings.
+    pub decimate: Option<usize>,
+    /// Decimation never moves the surface farther than this many cells from the true one (where
+    /// the input has a field to measure against); `None`: the target alone decides.
+    pub decimate_error: Option<f32>,
+    /// After meshing (and decimating), this many passes of feature-preserving smoothing
+    /// (see [`crate::mesh::smooth`]).
+    pub smooth: usize,
 }
 
 impl Default for Request {
@@ -133,6 +144,9 @@ impl Default for Request {
             tolerance: DmcOptions::default().tolerance,
             max_depth: None,
             samples_per_cell: DmcOptions::default().samples_per_cell,
+            decimate: None,
+            decimate_error: None,
+            smooth: 0,
         }
     }
 }
@@ -270,6 +284,31 @@ impl Meshed {
         Meshed { quads: out.mesh.quads, quad_stages: out.stages, ..Meshed::plain(mesh, phases) }
     }
 
+    /// Decimation and smoothing, where asked for, on the method's mesh: `truth` bounds the error and
+    /// projects smoothed vertices, `cell` sets the scale of the tolerances.
+    fn refine(mut self, request: &Request, truth: &dyn Field, cell: f32) -> Result<Meshed, Error> {
+        if let Some(target) = request.decimate {
+            let t0 = web_time::Instant::now();
+            let options = DecimateOptions {
+                target_triangles: target,
+                max_error: request.decimate_error.map(|e| (e * cell) as f64),
+                // Just under the 1 % of a cell promised, leaving room for f32 rounding.
+                feature_tolerance: 0.008 * cell as f64,
+                ..DecimateOptions::default()
+            };
+            let out = decimate(&self.mesh, &self.feature_edges, Some(truth), &options)?;
+            self.mesh = out.mesh;
+            self.feature_edges = out.feature_edges;
+            self.phases.push(("decimate".into(), mc::ms_since(t0)));
+        }
+        if request.smooth > 0 {
+            let t0 = web_time::Instant::now();
+            smooth(&mut self.mesh, &self.feature_edges, Some(truth), request.smooth)?;
+            self.phases.push(("smooth".into(), mc::ms_since(t0)));
+        }
+        Ok(self)
+    }
+
     /// The stats of the mesh, after the last check every output passes: coordinates that reached
     /// infinity or NaN in the method's arithmetic (samples near `f32::MAX`, say) are an error, never
     /// a mesh whose stats call it closed.
@@ -334,6 +373,7 @@ pub fn mesh_field(field: &dyn Field, bounds: (Vec3, Vec3), request: &Request) ->
         }
     };
     let shifted = Shifted { field, iso: request.iso };
+    let meshed = meshed.refine(request, &shifted, grid.cell_size())?;
     meshed.analyse(request.method, request.reported_res(), &shifted, request.analysis)
 }
 
@@ -437,6 +477,7 @@ pub fn mesh_samples(values: &[f32], grid: &Grid, request: &Request) -> Result<Ou
     };
     let field = SampledField { grid: *grid, values, gradient: request.gradient };
     let shifted = Shifted { field: &field, iso: request.iso };
+    let meshed = meshed.refine(request, &shifted, grid.cell_size())?;
     meshed.analyse(request.method, sampled_res(grid, request), &shifted, request.analysis)
 }
 

@@ -410,3 +410,32 @@ fn quad_method_writes_an_obj_of_quads_matching_its_stats() {
     assert_eq!(s["euler"], 2);
     assert!(s["quad_stages"].as_array().unwrap().len() >= 4);
 }
+
+#[test]
+fn decimate_and_smooth_run_after_the_method_and_show_in_the_phases() {
+    let s = stats(&[
+        "mesh",
+        "--scene",
+        "fandisk",
+        "--method",
+        "emc",
+        "--res",
+        "32",
+        "--decimate",
+        "600",
+        "--smooth",
+        "2",
+    ]);
+    let triangles = s["triangles"].as_u64().unwrap();
+    assert!(triangles <= 600 && triangles > 0, "{triangles} triangles");
+    assert_eq!(s["closed_manifold"], true);
+    assert_eq!(s["self_intersections"], 0);
+    assert!(
+        s["phases_ms"]["decimate"].is_number() && s["phases_ms"]["smooth"].is_number(),
+        "{}",
+        s["phases_ms"]
+    );
+    assert!(s["feature_edges"].as_u64().unwrap() > 0);
+    assert!(fails(&["mesh", "--scene", "sphere", "--decimate", "0"]).contains("decimate must be"));
+    assert!(fails(&["mesh", "--scene", "sphere", "--method", "quad", "--smooth", "1"]).contains("quad"));
+}

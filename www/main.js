@@ -12,7 +12,7 @@ import { showReference } from './reference.js';
 const $ = (id) => document.getElementById(id);
 const DEFAULT_SCENE = 'cube_minus_sphere';
 /** Options kept in the session and the link, by input id. */
-const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth'];
+const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth', 'decimate'];
 const CHECKS = ['auto-bounds', 'live', 'wireframe', 'features', 'normals', 'bad'];
 
 await init();
@@ -96,7 +96,9 @@ function fitBounds() {
 /** Options for one pane's method: grid methods take a resolution, DMC a tolerance and depth. */
 function options(method, bounds) {
   // The error numbers come after the mesh is shown (Pane.measure), not with it.
-  const common = { bounds };
+  const target = Number($('decimate').value);
+  // Quads would be broken up by decimation, which the library refuses for them.
+  const common = target >= 1 && method !== 'quad' ? { bounds, decimate: Math.floor(target) } : { bounds };
   if (method === 'dmc') {
     return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
   }
@@ -251,7 +253,7 @@ for (const id of ['theta', 'phi']) {
   });
   $(`${id}-slider`).addEventListener('change', optionChanged);
 }
-for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds']) {
+for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate']) {
   $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }
 for (const id of ['theta', 'phi']) $(id).addEventListener('input', showAngles);

@@ -152,6 +152,16 @@ struct MeshArgs {
     /// MCQ: leave inserted vertices in their polygon (the paper) instead of projecting them onto the surface.
     #[arg(long)]
     no_project: bool,
+    /// After meshing, decimate to at most this many triangles, keeping feature lines in place and
+    /// the mesh closed, manifold and free of crossings (not for --method quad).
+    #[arg(long)]
+    decimate: Option<usize>,
+    /// With --decimate: never move the surface farther than this many cells from the true one.
+    #[arg(long, requires = "decimate")]
+    decimate_error: Option<f32>,
+    /// After meshing (and decimating), this many passes of smoothing that leaves feature lines put.
+    #[arg(long, default_value_t = 0)]
+    smooth: usize,
     /// --grid only: the volume's gradient in the error stats, that of the trilinear interpolant or
     /// central differences at the samples interpolated (continuous across cells) [default: central].
     #[arg(long, value_enum, conflicts_with_all = NOT_GRID)]
@@ -233,6 +243,9 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         tolerance: args.tol,
         max_depth: args.max_depth,
         samples_per_cell: args.samples_per_cell,
+        decimate: args.decimate,
+        decimate_error: args.decimate_error,
+        smooth: args.smooth,
         ..Request::default()
     };
     let out = mesh_input(&args, &request)?;

@@ -3,8 +3,10 @@
 use glam::Vec3;
 
 pub mod analysis;
+pub mod decimate;
 pub mod export;
 pub mod pleats;
+pub mod smooth;
 
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from outside, so face normals
 /// (by the right-hand rule) point out of the solid.

@@ -92,7 +92,9 @@ pub fn mesh_triangles(mesh: &Mesh, request: &Request) -> Result<Output, Error> {
         }
     };
     let res = sampled_res(&grid, request);
-    meshed.analyse(request.method, res, &MeshDistance::new(&source, bounds), request.analysis)
+    let truth = MeshDistance::new(&source, bounds);
+    let meshed = meshed.refine(request, &truth, grid.cell_size())?;
+    meshed.analyse(request.method, res, &truth, request.analysis)
 }
 
 /// Reconstructs the surface an oriented point cloud samples. Normals should point out of the
@@ -118,7 +120,9 @@ pub fn mesh_points(cloud: &PointCloud, request: &Request) -> Result<Output, Erro
         }
     };
     let res = sampled_res(&grid, request);
-    meshed.analyse(request.method, res, &PlaneDistance(&index), request.analysis)
+    let truth = PlaneDistance(&index);
+    let meshed = meshed.refine(request, &truth, grid.cell_size())?;
+    meshed.analyse(request.method, res, &truth, request.analysis)
 }
 
 /// Signed distance to a triangle mesh, the truth a remeshed mesh is measured against: the

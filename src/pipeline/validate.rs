@@ -40,6 +40,7 @@ impl Request {
             // Grid::new checks finiteness, max > min and that f32 can resolve one cell there.
             Grid::new(min, max, [1, 1, 1])?;
         }
+        self.validate_refinement()?;
         match self.method {
             Method::Mc => self.mc_options().validate(),
             Method::Emc => self.emc_options().validate(),
@@ -47,6 +48,34 @@ impl Request {
             Method::Mcq => self.mcq_options().validate(),
             Method::Quad => validate_quad(&self.quad),
         }
+    }
+}
+
+/// Most smoothing passes accepted: past a few dozen a surface only gets slower to smooth.
+pub const MAX_SMOOTH_PASSES: usize = 100;
+
+impl Request {
+    /// Decimation and smoothing, shared by every method but the quad one, whose quads they would
+    /// break up.
+    fn validate_refinement(&self) -> Result<(), Error> {
+        let bad = |msg: String| Err(Error::InvalidOption(msg));
+        if self.method == Method::Quad && (self.decimate.is_some() || self.smooth > 0) {
+            return bad(
+                "decimate and smooth do not apply to the quad method (they would break its quads)".into()
+            );
+        }
+        if self.decimate == Some(0) {
+            return bad("decimate must be a target of at least 1 triangle, got 0".into());
+        }
+        if let Some(e) = self.decimate_error {
+            if !(e.is_finite() && e > 0.0) {
+                return bad(format!("decimateError must be a positive number of cells, got {e}"));
+            }
+        }
+        if self.smooth > MAX_SMOOTH_PASSES {
+            return bad(format!("smooth must lie in 0..={MAX_SMOOTH_PASSES}, got {}", self.smooth));
+        }
+        Ok(())
     }
 }
 

@@ -39,6 +39,9 @@ struct JsOptions {
     project: Option<bool>,
     dtype: Option<String>,
     gradient: Option<String>,
+    decimate: Option<f64>,
+    decimate_error: Option<f32>,
+    smooth: Option<f64>,
 }
 
 /// Options of every function but meshGrid, which alone takes a `dtype`.
@@ -130,6 +133,14 @@ pub(super) fn parse_grid_options(
         r.mcq_snap = (a != 0.0).then_some(a);
     }
     r.mcq_project = o.project.unwrap_or(r.mcq_project);
+    // A target of 0 is refused by the request's validation, with the same words as the CLI's.
+    if let Some(n) = o.decimate {
+        r.decimate = Some(whole("decimate", n, 1e9)? as usize);
+    }
+    r.decimate_error = o.decimate_error;
+    if let Some(n) = o.smooth {
+        r.smooth = whole("smooth", n, 1e6)? as usize;
+    }
     if let Some(g) = &o.gradient {
         r.gradient = SampleGradient::parse(g).map_err(js_error)?;
     }

@@ -75,6 +75,15 @@ export interface MeshOptions {
   snap?: number;
   /** MCQ: project inserted and merged vertices onto the surface (default true; the paper does not). */
   project?: boolean;
+  /**
+   * After meshing, decimate to at most this many triangles (not for method "quad"): feature lines
+   * stay where they are, the mesh stays closed, manifold and free of crossings.
+   */
+  decimate?: number;
+  /** With decimate: never move the surface farther than this many cells from the true one. */
+  decimateError?: number;
+  /** After meshing (and decimating), this many passes of smoothing that leaves feature lines put (0 to 100, default 0). */
+  smooth?: number;
 }
 
 /** Options of meshGrid: the shared ones plus the sample type. */

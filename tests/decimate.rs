@@ -1,0 +1,277 @@
+//! Feature-sensitive decimation and smoothing (issue 18, the EMC paper's §5) on EMC's meshes of
+//! the scenes and of seeded random CSG trees: what `--decimate` and `--smooth` promise.
+//!
+//! - the mesh keeps its topology: a manifold with the input's border, Euler characteristic and
+//!   components, no degenerate triangles, no crossings;
+//! - every feature edge of the input (sampled along its length) stays within 1 % of a cell of the
+//!   output's feature lines;
+//! - with an error bound of twice undecimated EMC's largest distance, the triangle count drops by
+//!   10× or more (fandisk at 128; the cube minus a ball at 256, ignored for its time, since at 128
+//!   its curved part holds it to 8×).
+//!
+//! Heavy cases are `#[ignore]`d: `cargo test --release --test decimate -- --ignored --nocapture`.
+
+mod common;
+
+use common::csg::random_tree;
+use common::{case_seeds, Rng};
+use isoforge::expr;
+use isoforge::mesh::analysis::{self, Topology};
+use isoforge::pipeline::{self, Method, Output, Request};
+use isoforge::stats::AnalysisOptions;
+use isoforge::{scenes, Vec3};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
+
+fn request(res: usize) -> Request {
+    Request {
+        method: Method::Emc,
+        res,
+        analysis: AnalysisOptions { self_intersections: false, surface_error: false },
+        ..Request::default()
+    }
+}
+
+/// The cell side of `res` cells along the longest side of a scene's bounds.
+fn scene_cell(name: &str, res: usize) -> f32 {
+    let scene = scenes::scene(name).unwrap();
+    (scene.max - scene.min).max_element() / res as f32
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let d = b - a;
+    let t =
+        if d.length_squared() > 0.0 { ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + t * d)).length()
+}
+
+/// The largest distance from points along the input's feature edges (ends, quarters, middle) to
+/// the nearest feature edge of the output.
+fn feature_drift(input: &Output, output: &Output) -> f32 {
+    let segments: Vec<(Vec3, Vec3)> = output
+        .feature_edges
+        .iter()
+        .map(|&[a, b]| (output.mesh.positions[a as usize], output.mesh.positions[b as usize]))
+        .collect();
+    let mut worst = 0.0f32;
+    for &[a, b] in &input.feature_edges {
+        let (pa, pb) = (input.mesh.positions[a as usize], input.mesh.positions[b as usize]);
+        for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let p = pa.lerp(pb, t);
+            let nearest =
+                segments.iter().map(|&(s, e)| segment_distance(p, s, e)).fold(f32::INFINITY, f32::min);
+            worst = worst.max(nearest);
+        }
+    }
+    worst
+}
+
+/// What decimation and smoothing promise of `output` made from `input` (see the module doc).
+fn assert_kept(input: &Output, output: &Output, cell: f32, what: &str) -> Topology {
+    let (before, after) = (analysis::topology(&input.mesh), analysis::topology(&output.mesh));
+    assert_eq!(
+        (
+            after.non_manifold_edges,
+            after.misoriented_edges,
+            after.non_manifold_vertices,
+            after.degenerate_triangles
+        ),
+        (0, 0, 0, 0),
+        "{what}: not an oriented manifold: {after:?}"
+    );
+    assert_eq!(after.boundary_edges, before.boundary_edges, "{what}: border changed");
+    assert_eq!(
+        (after.euler, after.components),
+        (before.euler, before.components),
+        "{what}: topology changed"
+    );
+    assert_eq!(analysis::self_intersections(&output.mesh), 0, "{what}: crossings");
+    let drift = feature_drift(input, output);
+    assert!(drift <= 0.01 * cell, "{what}: a feature edge moved {} cells", drift / cell);
+    after
+}
+
+#[test]
+fn scenes_decimated_towards_a_tenth_keep_topology_creases_and_no_crossings() {
+    for name in ["cube_minus_sphere", "fandisk", "rotated_box", "gear", "sphere", "torus"] {
+        let res = 40;
+        let input = pipeline::mesh_scene(name, &request(res)).unwrap();
+        let target = input.mesh.triangle_count() / 10;
+        let output = pipeline::mesh_scene(name, &Request { decimate: Some(target), ..request(res) }).unwrap();
+        let topo = assert_kept(&input, &output, scene_cell(name, res), name);
+        assert!(topo.is_closed_manifold(), "{name}: {topo:?}");
+        // The gear's many short curved creases keep the most vertices: 3.4× fewer at this size.
+        assert!(
+            output.mesh.triangle_count() * 3 <= input.mesh.triangle_count(),
+            "{name}: {} of {} triangles left, target {target}",
+            output.mesh.triangle_count(),
+            input.mesh.triangle_count()
+        );
+    }
+}
+
+/// Triangles and largest distance of EMC at `res` on `name`, and of EMC decimated with an error
+/// bound of twice that distance.
+fn ratio_at_twice_the_error(name: &str, res: usize) -> (usize, f64, usize, f64) {
+    let scene = scenes::scene(name).unwrap();
+    let field = scene.field.as_ref();
+    let cell = scene_cell(name, res);
+    let input = pipeline::mesh_scene(name, &request(res)).unwrap();
+    let before = analysis::surface_error(&input.mesh, field).dist_max;
+    let bounded =
+        Request { decimate: Some(1), decimate_error: Some(2.0 * before as f32 / cell), ..request(res) };
+    let output = pipeline::mesh_scene(name, &bounded).unwrap();
+    let after = analysis::surface_error(&output.mesh, field).dist_max;
+    let topo = assert_kept(&input, &output, cell, name);
+    assert!(topo.is_closed_manifold());
+    eprintln!(
+        "{name} {res}: {} -> {} triangles, max distance {before:.6} -> {after:.6}",
+        input.mesh.triangle_count(),
+        output.mesh.triangle_count()
+    );
+    (input.mesh.triangle_count(), before, output.mesh.triangle_count(), after)
+}
+
+#[test]
+// Seconds natively, a minute in the browser: the ratio does not depend on the target.
+#[cfg_attr(target_arch = "wasm32", ignore)]
+fn fandisk_at_128_loses_ninety_percent_of_its_triangles_within_twice_emcs_error() {
+    let (before, error_before, after, error_after) = ratio_at_twice_the_error("fandisk", 128);
+    assert!(after * 10 <= before, "{before} -> {after} triangles");
+    // 1 % over for the f32 rounding of the written mesh.
+    assert!(error_after <= 2.0 * error_before * 1.01, "{error_before} -> {error_after}");
+}
+
+/// At 128 the ball's curvature bounds the triangles' size: vertices on a ball of radius 0.75 and
+/// faces within 0.0002 of it need about 7 000 triangles on the ball alone, so 8× is what is there.
+#[test]
+// Seconds natively, a minute in the browser: the ratio does not depend on the target.
+#[cfg_attr(target_arch = "wasm32", ignore)]
+fn cube_minus_sphere_at_128_loses_most_of_its_triangles_within_twice_emcs_error() {
+    let (before, error_before, after, error_after) = ratio_at_twice_the_error("cube_minus_sphere", 128);
+    assert!(after * 15 <= before * 2, "{before} -> {after} triangles: under 7.5×");
+    assert!(error_after <= 2.0 * error_before * 1.01, "{error_before} -> {error_after}");
+}
+
+/// EMC's 300 000 triangles at 256³ (about 20 s in a release build).
+#[test]
+#[ignore]
+fn cube_minus_sphere_at_256_loses_ninety_percent_of_its_triangles_within_twice_emcs_error() {
+    let (before, error_before, after, error_after) = ratio_at_twice_the_error("cube_minus_sphere", 256);
+    assert!(after * 10 <= before, "{before} -> {after} triangles");
+    assert!(error_after <= 2.0 * error_before * 1.01, "{error_before} -> {error_after}");
+}
+
+#[test]
+fn smoothing_leaves_features_and_distance_and_evens_out_normals() {
+    let name = "fandisk";
+    let res = 48;
+    let with_error = |r: Request| Request {
+        analysis: AnalysisOptions { self_intersections: false, surface_error: true },
+        ..r
+    };
+    let input = pipeline::mesh_scene(name, &with_error(request(res))).unwrap();
+    let output = pipeline::mesh_scene(name, &with_error(Request { smooth: 5, ..request(res) })).unwrap();
+    let topo = assert_kept(&input, &output, scene_cell(name, res), name);
+    assert!(topo.is_closed_manifold());
+    for &[a, b] in &input.feature_edges {
+        for v in [a, b] {
+            assert_eq!(
+                input.mesh.positions[v as usize], output.mesh.positions[v as usize],
+                "feature vertex {v} moved"
+            );
+        }
+    }
+    let (before, after) = (input.stats.dist_max.unwrap(), output.stats.dist_max.unwrap());
+    assert!(after <= before * 1.01, "max distance {before} -> {after}");
+    let (p50_before, p50_after) =
+        (input.stats.normal_dev_deg_p50.unwrap(), output.stats.normal_dev_deg_p50.unwrap());
+    assert!(p50_after <= p50_before + 0.01, "normal deviation p50 {p50_before} -> {p50_after}");
+    let moved = input.mesh.positions.iter().zip(&output.mesh.positions).filter(|(a, b)| a != b).count();
+    assert!(moved * 2 > input.mesh.vertex_count(), "only {moved} vertices moved: smoothing did nothing");
+}
+
+/// Seeded random CSG trees (see `props_csg.rs`), EMC at 16–32 cells, decimated to a quarter:
+/// still an oriented manifold with the input's border, topology and creases, no crossings.
+#[test]
+fn prop_decimated_emc_of_random_trees_keeps_its_promises() {
+    for seed in case_seeds(0xDEC1_0000, 12) {
+        let mut rng = Rng::new(seed);
+        let tree = random_tree(&mut rng);
+        let program = expr::compile(&tree.text).unwrap();
+        let res = 16 + rng.below(17) as usize;
+        let what = format!("seed {seed}, res {res}: {}", tree.text);
+        let input = pipeline::mesh_program(&program, &request(res)).unwrap();
+        let target = input.mesh.triangle_count() / 4;
+        let output =
+            pipeline::mesh_program(&program, &Request { decimate: Some(target.max(1)), ..request(res) })
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_kept(&input, &output, 2.0 / res as f32, &what);
+    }
+}
+
+#[test]
+fn bad_decimate_and_smooth_values_are_refused_by_name() {
+    let err = |r: Request| pipeline::mesh_scene("sphere", &r).unwrap_err().to_string();
+    assert!(err(Request { decimate: Some(0), ..request(8) }).contains("decimate"));
+    assert!(err(Request { decimate: Some(10), decimate_error: Some(-1.0), ..request(8) })
+        .contains("decimateError"));
+    assert!(err(Request { smooth: 1000, ..request(8) }).contains("smooth"));
+    assert!(err(Request { method: Method::Quad, decimate: Some(10), ..request(8) }).contains("quad"));
+}
+
+/// The share of triangles with a corner under 10°.
+fn sliver_share(mesh: &isoforge::Mesh) -> f64 {
+    let slivers = (0..mesh.triangle_count())
+        .filter(|&t| {
+            let c = mesh.corners(t);
+            (0..3).any(|i| {
+                let (a, b) = (c[(i + 1) % 3] - c[i], c[(i + 2) % 3] - c[i]);
+                a.angle_between(b).to_degrees() < 10.0
+            })
+        })
+        .count();
+    slivers as f64 / mesh.triangle_count().max(1) as f64
+}
+
+/// The issue's goal, fewer than 2 % of the triangles under 10° without moving a feature point,
+/// where EMC has 6.0 % (cube minus a ball, decimated: 0 %) and 15.8 % (rotated box: 1.3 %) at 64
+/// cells; the fandisk goes from 0.9 % to 2.0 %, its fixed feature vertices keeping their slivers
+/// as the rest thins out. Not the gear: its teeth's fans keep 9.6 % (docs/decimate.md).
+#[test]
+#[cfg_attr(target_arch = "wasm32", ignore)]
+fn decimation_to_a_tenth_leaves_few_slivers() {
+    for (name, most) in [("cube_minus_sphere", 0.02), ("rotated_box", 0.02), ("fandisk", 0.025)] {
+        let res = 64;
+        let input = pipeline::mesh_scene(name, &request(res)).unwrap();
+        let target = input.mesh.triangle_count() / 10;
+        let output = pipeline::mesh_scene(name, &Request { decimate: Some(target), ..request(res) }).unwrap();
+        let (before, after) = (sliver_share(&input.mesh), sliver_share(&output.mesh));
+        eprintln!("{name}: {:.1} % -> {:.1} % under 10°", 100.0 * before, 100.0 * after);
+        assert!(after < most, "{name}: {:.1} % of the triangles under 10°", 100.0 * after);
+        assert_kept(&input, &output, scene_cell(name, res), name);
+    }
+}
+
+/// Every triangle method's mesh can be decimated (no feature lines: only the quadrics and the
+/// checks protect the creases): the topology and the absence of crossings hold for all.
+#[test]
+fn every_triangle_method_decimates_to_a_closed_manifold_without_crossings() {
+    for method in [Method::Mc, Method::Mcq, Method::Dmc, Method::Emc] {
+        let res = 32;
+        let input = pipeline::mesh_scene("cube_minus_sphere", &Request { method, ..request(res) }).unwrap();
+        let target = input.mesh.triangle_count() / 4;
+        let output = pipeline::mesh_scene(
+            "cube_minus_sphere",
+            &Request { method, decimate: Some(target), ..request(res) },
+        )
+        .unwrap();
+        let topo = assert_kept(&input, &output, scene_cell("cube_minus_sphere", res), method.name());
+        assert!(topo.is_closed_manifold(), "{method:?}: {topo:?}");
+        assert!(output.mesh.triangle_count() * 3 <= input.mesh.triangle_count(), "{method:?}");
+    }
+}
