@@ -1,9 +1,10 @@
 //! Data parallelism where the platform has threads: natively on rayon's pool, in wasm (one thread,
 //! no shared memory) as the same loops run in order.
 //!
-//! Every parallel section here hands out fixed pieces of work (slabs of a grid, chunks of a list)
-//! whose results are put together in the pieces' order, and how the work is cut never depends on
-//! how many threads there are: the output is the same bit for bit with one thread or many.
+//! Every parallel section hands out pieces of work (slabs of a grid, chunks of a list) whose
+//! results are put together in the pieces' order, and either the cut never depends on the number
+//! of threads, or (see [`piece_len`]) the joined pieces are by construction what one piece gives:
+//! the output is the same bit for bit with one thread or many.
 //!
 //! Progress checkpoints ([`crate::progress`]) are thread-local: the callers keep them outside the
 //! closures given here, between parallel sections, on the job's own thread.
@@ -48,6 +49,17 @@ pub fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> 
     #[cfg(target_arch = "wasm32")]
     {
         (a(), b())
+    }
+}
+
+/// How long the pieces of `total` items are to be cut: one piece where there is one thread (no
+/// joining to pay for), else about four per thread for balance, at least `min` long. Only for
+/// sections whose joined output is, by construction, that of one piece (Marching Cubes' and
+/// EMC's slabs).
+pub fn piece_len(total: usize, min: usize) -> usize {
+    match threads() {
+        0 | 1 => total.max(1),
+        n => total.div_ceil(4 * n).max(min).max(1),
     }
 }
 

@@ -263,12 +263,12 @@ fn crossing(
     (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
 }
 
-/// The grid's cells in slabs of [`SLAB_LAYERS`] cell layers, a few at a time in parallel
-/// ([`crate::par`], one per thread between checkpoints), joined as Marching Cubes joins its slabs
-/// ([`crate::mc::extract`]): a slab's vertices on its lowest point layer are the slab below's, so
-/// the mesh is the one sweep's, vertex for vertex, whatever the threads. A crossing on a shared
-/// layer is computed by both slabs from the same edge and samples, so both decide their cells
-/// with the same point.
+/// The grid's cells in slabs of cell layers, one per thread at a time between checkpoints
+/// ([`crate::par`]), joined as Marching Cubes joins its slabs ([`crate::mc::extract`]): a slab's
+/// vertices on its lowest point layer are the slab below's, so the mesh is the one sweep's,
+/// vertex for vertex, however the grid is cut. A crossing on a shared layer is computed by both
+/// slabs from the same edge and samples, so both decide their cells with the same point. On one
+/// thread the slabs are [`CHECKPOINT_LAYERS`] high, so a stop is seen that often.
 fn extract(
     values: &[f32],
     grid: &Grid,
@@ -276,21 +276,23 @@ fn extract(
     sampler: &dyn EdgeSampler,
 ) -> Result<(EmcMesh, FanCentres, Vec<OutsideFan>), Error> {
     let cz = grid.cells[2];
-    let slabs = cz.div_ceil(SLAB_LAYERS);
     let per_step = crate::par::threads();
+    let layers = crate::par::piece_len(cz, crate::mc::MIN_SLAB_LAYERS).min(CHECKPOINT_LAYERS);
+    let slabs = cz.div_ceil(layers);
     let mut parts = Vec::with_capacity(slabs);
     for first in (0..slabs).step_by(per_step) {
-        crate::progress::checkpoint("extract", (first * SLAB_LAYERS) as f32 / cz as f32)?;
+        crate::progress::checkpoint("extract", (first * layers) as f32 / cz as f32)?;
         parts.extend(crate::par::map(per_step.min(slabs - first), |s| {
-            let start = (first + s) * SLAB_LAYERS;
-            extract_slab(values, grid, options, sampler, start..(start + SLAB_LAYERS).min(cz))
+            let start = (first + s) * layers;
+            extract_slab(values, grid, options, sampler, start..(start + layers).min(cz))
         }));
     }
     Ok(join_slabs(parts))
 }
 
-/// Cell layers per slab of [`extract`]: fixed, so the output does not depend on the threads.
-const SLAB_LAYERS: usize = 16;
+/// Cell layers a slab of [`extract`] has at most: EMC spends milliseconds per layer at fine
+/// resolutions, and a stop asked for in the page should not wait much longer than that.
+const CHECKPOINT_LAYERS: usize = 16;
 
 /// One slab's output, its vertex ids its own; `bottom` and `top` are the ids its edge cache gave
 /// the x and y edges of its lowest and highest point layers.

@@ -223,22 +223,23 @@ impl EdgeCache {
     }
 }
 
-/// Cell layers per slab of [`extract`]: fixed, so the output does not depend on the threads.
-const SLAB_LAYERS: usize = 16;
+/// Cell layers a slab of [`extract`] has at least (where there are threads to cut for).
+pub(crate) const MIN_SLAB_LAYERS: usize = 8;
 
 /// Extracts the `options.iso` level set of a sampled grid.
 ///
-/// Slabs of [`SLAB_LAYERS`] cell layers are extracted in parallel ([`crate::par`]), each with
-/// vertex ids of its own, then joined in order: a slab's vertices on its lowest point layer are
-/// the ones the slab below made on its highest (both made them from the same two samples, so they
-/// are the same points), and the rest keep the order they were made in. That is exactly the mesh
-/// one sweep over the whole grid makes, vertex for vertex, whatever the number of threads.
+/// Slabs of cell layers ([`crate::par::piece_len`]: one slab on one thread) are extracted in
+/// parallel, each with vertex ids of its own, then joined in order: a slab's vertices on its
+/// lowest point layer are the ones the slab below made on its highest (both made them from the
+/// same two samples, so they are the same points), and the rest keep the order they were made in.
+/// That is exactly the mesh one sweep over the whole grid makes, vertex for vertex, however the
+/// grid is cut.
 pub fn extract(values: &[f32], grid: &Grid, options: &McOptions) -> Result<Mesh, Error> {
     check_finite(values, grid)?;
     let cz = grid.cells[2];
-    let slabs = crate::par::map(cz.div_ceil(SLAB_LAYERS), |s| {
-        let layers = s * SLAB_LAYERS..((s + 1) * SLAB_LAYERS).min(cz);
-        extract_slab(values, grid, options, layers)
+    let layers = crate::par::piece_len(cz, MIN_SLAB_LAYERS);
+    let slabs = crate::par::map(cz.div_ceil(layers), |s| {
+        extract_slab(values, grid, options, s * layers..((s + 1) * layers).min(cz))
     });
     Ok(join_slabs(slabs))
 }
