@@ -3,7 +3,7 @@
 //! meets a triangle, and its normal is that triangle's, so sharp edges and corners of the input
 //! come back as feature lines and corners of the output.
 //!
-//! For a mesh with holes or a border ([`open_edges`]) the votes below are not defined (a line
+//! For a mesh with holes or a border (`open_edges`) the votes below are not defined (a line
 //! through a hole counts one crossing too few from there on), and inside is where the generalised
 //! winding number ([`super::winding`]) exceeds 1/2 instead: the holes are closed by a surface
 //! spanning their rims, with crossings interpolated where a grid edge passes through a hole. A
@@ -63,7 +63,7 @@ pub struct MeshBvh {
     pub duplicates: usize,
     /// Whether the input was inside out (negative enclosed volume) and was turned around.
     pub flipped: bool,
-    /// Edges of the input used by an odd number of triangles ([`open_edges`]): the edges of its
+    /// Edges of the input used by an odd number of triangles (`open_edges`): the edges of its
     /// holes or border. Where there are any, inside is decided by the generalised winding number.
     pub open_edges: usize,
     winding: Option<WindingTree>,

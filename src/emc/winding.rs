@@ -6,7 +6,7 @@
 //!
 //! Summing every triangle at every grid point costs triangles × points; far triangles are summed
 //! in clusters instead (Barill et al. 2018 use a series; here only its first term): a cluster
-//! seen from farther than [`FAR`] times its radius subtends about `A·(c − p) / |c − p|³`, with `A`
+//! seen from farther than `FAR` times its radius subtends about `A·(c − p) / |c − p|³`, with `A`
 //! the sum of its triangles' vector areas and `c` their area-weighted centre. The error of that
 //! dipole term falls with the square of radius over distance: a few hundredths in all (0.03 at
 //! the centre of a sphere of 2 000 triangles), against the 1/2 the sign is read at; next to the
