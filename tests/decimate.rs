@@ -27,12 +27,7 @@ use wasm_bindgen_test::wasm_bindgen_test as test;
 wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
 fn request(res: usize) -> Request {
-    Request {
-        method: Method::Emc,
-        res,
-        analysis: AnalysisOptions { self_intersections: false, surface_error: false },
-        ..Request::default()
-    }
+    common::bare_request(Method::Emc, res)
 }
 
 /// The cell side of `res` cells along the longest side of a scene's bounds.
