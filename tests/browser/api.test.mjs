@@ -252,3 +252,32 @@ test('analyzeMesh measures a result after the fact: the same error as surfaceErr
   assert.match(r.errors[4], /vertex 0 is not finite/);
   assert.match(r.errors[5], /checkIntersections must be a boolean/);
 });
+
+test('decimate, decimateError and smooth pass through to the mesh, and bad values are refused by name', async () => {
+  const r = await inPage((m) => {
+    const text = 'subtract(box(0.6, 0.6, 0.6), sphere(0.75))';
+    const plain = m.meshExpr(text, { method: 'emc', res: 40, surfaceError: true });
+    const fewer = m.meshExpr(text, { method: 'emc', res: 40, decimate: 2500 });
+    const bounded = m.meshExpr(text, { method: 'emc', res: 40, decimate: 1, decimateError: 0.1, surfaceError: true });
+    const smooth = m.meshExpr(text, { method: 'emc', res: 40, smooth: 3 });
+    const errors = [];
+    for (const o of [{ decimate: -1 }, { decimateError: -0.5 }, { smooth: 1.5 }]) {
+      try { m.meshExpr(text, { method: 'emc', res: 16, ...o }); errors.push(null); } catch (e) { errors.push(e.message); }
+    }
+    const pick = (x) => ({ triangles: x.stats.triangles, closed: x.stats.closed_manifold, euler: x.stats.euler, features: x.featureEdges.length, phases: Object.keys(x.stats.phases_ms) });
+    return { plain: { ...pick(plain), dist: plain.stats.dist_max }, fewer: pick(fewer), bounded: { ...pick(bounded), dist: bounded.stats.dist_max }, smooth: pick(smooth), errors };
+  });
+  for (const x of [r.fewer, r.bounded, r.smooth]) {
+    assert.equal(x.closed, true);
+    assert.equal(x.euler, -8);
+    assert.ok(x.features > 0, 'feature lines kept');
+  }
+  assert.ok(r.fewer.triangles <= 2500 && r.plain.triangles > 2 * 2500, `${r.plain.triangles} -> ${r.fewer.triangles}`);
+  assert.ok(r.fewer.phases.includes('decimate') && r.smooth.phases.includes('smooth'));
+  // No farther from the surface than a tenth of a cell (2 / 40) or EMC's own farthest point,
+  // with far fewer triangles than EMC's.
+  assert.ok(r.bounded.dist <= Math.max(0.1 * 2 / 40, r.plain.dist) * 1.001, JSON.stringify([r.bounded, r.plain]));
+  assert.ok(r.bounded.triangles < r.plain.triangles / 2, JSON.stringify(r.bounded));
+  assert.equal(r.smooth.triangles, r.plain.triangles, 'smoothing moves vertices, it does not remesh');
+  for (const [e, name] of [[r.errors[0], /decimate/], [r.errors[1], /decimateError/], [r.errors[2], /smooth/]]) assert.match(String(e), name);
+});

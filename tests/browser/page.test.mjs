@@ -171,3 +171,26 @@ test('sliders set the options they stand beside: an angle in degrees becomes its
   await settled(page);
   assert.ok(await count(page, LEFT, 'feature edges') >= loose);
 });
+
+test('"Decimate to" shrinks both sides to the target, closed, with the frame\'s topology, and is kept in the link', async () => {
+  // 3 000 is within reach of both sides at 48 cells (EMC's corners and curved rims keep about
+  // 1 800 vertices' worth of triangles; below that it stops short of the target).
+  const { page } = await openDemo();
+  const before = await count(page, LEFT, 'triangles');
+  await page.fill('#decimate', '3000');
+  await page.click('#run');
+  await settled(page);
+  for (const side of [LEFT, RIGHT]) {
+    assert.ok(await count(page, side, 'triangles') <= 3000, side);
+    assert.equal(await stat(page, side, 'closed manifold'), 'yes', side);
+    assert.equal(await stat(page, side, 'Euler characteristic'), '-8', side);
+    assert.equal(await count(page, side, 'crossing pairs'), 0, side);
+  }
+  assert.ok(before > 3 * 3000, `EMC had ${before} triangles before`);
+  assert.ok(await count(page, LEFT, 'feature edges') > 0, 'EMC keeps its feature lines');
+  const link = page.url();
+  const again = await page.context().newPage();
+  await again.goto(link);
+  assert.equal(await again.inputValue('#decimate'), '3000');
+  await again.close();
+});
