@@ -95,8 +95,8 @@ fn run_column(instr: &Instr, cols: &mut [Column]) {
                 BinaryOp::Sub => lanes.for_each(|(o, (a, b))| *o = a - b),
                 BinaryOp::Mul => lanes.for_each(|(o, (a, b))| *o = a * b),
                 BinaryOp::Div => lanes.for_each(|(o, (a, b))| *o = a / b),
-                BinaryOp::Min => lanes.for_each(|(o, (a, b))| *o = a.min(*b)),
-                BinaryOp::Max => lanes.for_each(|(o, (a, b))| *o = a.max(*b)),
+                BinaryOp::Min => lanes.for_each(|(o, (&a, &b))| *o = ops::min(a, b)),
+                BinaryOp::Max => lanes.for_each(|(o, (&a, &b))| *o = ops::max(a, b)),
                 op => lanes.for_each(|(o, (&a, &b))| *o = ops::binary(op, a, b)),
             }
         }

@@ -69,10 +69,36 @@ pub fn binary(op: BinaryOp, a: f32, b: f32) -> f32 {
         BinaryOp::Sub => a - b,
         BinaryOp::Mul => a * b,
         BinaryOp::Div => a / b,
-        BinaryOp::Min => a.min(b),
-        BinaryOp::Max => a.max(b),
+        BinaryOp::Min => min(a, b),
+        BinaryOp::Max => max(a, b),
         BinaryOp::Pow => a.powf(b),
         BinaryOp::Atan2 => a.atan2(b),
+    }
+}
+
+/// The smaller of `a` and `b`, ignoring a NaN operand as `f32::min` does (`a` on a tie). Written
+/// as two selects: wasm has no instruction with `f32::min`'s NaN rule, so LLVM turns `f32::min`
+/// into a branchy sequence per lane there, while selects vectorise (the 64-lane columns of
+/// [`super::columns`]). Every evaluator calls this one, so they agree bit for bit.
+#[inline]
+pub fn min(a: f32, b: f32) -> f32 {
+    let smaller = if b < a { b } else { a };
+    if a.is_nan() {
+        b
+    } else {
+        smaller
+    }
+}
+
+/// The larger of `a` and `b`, ignoring a NaN operand as `f32::max` does (`a` on a tie); see
+/// [`min`].
+#[inline]
+pub fn max(a: f32, b: f32) -> f32 {
+    let larger = if b > a { b } else { a };
+    if a.is_nan() {
+        b
+    } else {
+        larger
     }
 }
 
