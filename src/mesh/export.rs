@@ -187,8 +187,8 @@ fn check(mesh: &Mesh) -> io::Result<bool> {
             mesh.normals.len()
         )));
     }
-    if let Some(t) = mesh.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
-        return Err(invalid(&format!("triangle {t} {:?} refers past the {n} vertices", mesh.triangles[t])));
+    if let Some(message) = mesh.index_error() {
+        return Err(invalid(&message));
     }
     Ok(!mesh.normals.is_empty())
 }

@@ -27,6 +27,15 @@ impl Mesh {
         self.triangles.len()
     }
 
+    /// What is wrong with the first triangle that names a vertex past `positions`, or `None` when
+    /// every index is in range: meshes built from outside arrays (files, JavaScript) are checked
+    /// with it before anything indexes them.
+    pub fn index_error(&self) -> Option<String> {
+        let n = self.positions.len();
+        let t = self.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n))?;
+        Some(format!("triangle {t} {:?} refers past the {n} vertices", self.triangles[t]))
+    }
+
     /// The three corner positions of triangle `t`.
     #[inline]
     pub fn corners(&self, t: usize) -> [Vec3; 3] {

@@ -57,9 +57,8 @@ pub fn analyze_mesh(
     let started = Instant::now();
     let mesh = mesh_from_arrays(&result)?;
     let invalid = |message: String| js_error(Error::InvalidOption(message));
-    let n = mesh.positions.len();
-    if let Some(t) = mesh.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
-        return Err(invalid(format!("triangle {t} {:?} refers past the {n} vertices", mesh.triangles[t])));
+    if let Some(message) = mesh.index_error() {
+        return Err(invalid(message));
     }
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(invalid(format!("vertex {v} is not finite: {:?}", mesh.positions[v].to_array())));
