@@ -295,6 +295,13 @@ pub fn check_finite(values: &[f32], grid: &Grid) -> Result<(), Error> {
             values.len()
         )));
     }
+    // One vectorised pass proves the common case; only a grid with a bad sample is searched again
+    // for the first one, non-finite samples before oversized ones. (`abs() <= MAX` is false for
+    // NaN and the infinities too.)
+    let in_range = |chunk: &[f32]| chunk.iter().fold(true, |ok, v| ok & (v.abs() <= MAX_SAMPLE_MAGNITUDE));
+    if values.chunks(4096).all(in_range) {
+        return Ok(());
+    }
     if let Some(n) = values.iter().position(|v| !v.is_finite()) {
         let [i, j, k] = grid.unindex(n);
         return Err(Error::NonFiniteSample {

@@ -179,6 +179,10 @@ pub(crate) struct EdgeCache {
     /// x- and y-edges of the lower and upper layer: `[layer][axis][i + nx * j]`.
     layer_edges: [[Vec<u32>; 2]; 2],
     z_edges: Vec<u32>,
+    /// Slots handed out while empty, per plane (lower x, lower y, upper x, upper y, z): a layer
+    /// is cleared by resetting these rather than the whole plane, which at 256² points per layer
+    /// cost more than the crossed cells did.
+    touched: [Vec<u32>; 5],
     /// The x- and y-edges of the first layer, kept when the sweep leaves it (for joining slabs).
     first_layer: Option<[Vec<u32>; 2]>,
 }
@@ -190,18 +194,28 @@ impl EdgeCache {
             nx,
             layer_edges: [[plane(), plane()], [plane(), plane()]],
             z_edges: plane(),
+            touched: Default::default(),
             first_layer: None,
         }
     }
 
     pub(crate) fn advance(&mut self) {
         self.layer_edges.swap(0, 1);
+        self.touched.swap(0, 2);
+        self.touched.swap(1, 3);
         if self.first_layer.is_none() {
             let fresh = [vec![NONE; self.z_edges.len()], vec![NONE; self.z_edges.len()]];
             self.first_layer = Some(std::mem::replace(&mut self.layer_edges[1], fresh));
+            self.touched[2].clear();
+            self.touched[3].clear();
         }
-        for plane in self.layer_edges[1].iter_mut().chain(std::iter::once(&mut self.z_edges)) {
-            plane.fill(NONE);
+        let [[_, _], [upper_x, upper_y]] = &mut self.layer_edges;
+        let [_, _, touched_x, touched_y, touched_z] = &mut self.touched;
+        for (plane, touched) in [(upper_x, touched_x), (upper_y, touched_y), (&mut self.z_edges, touched_z)] {
+            for &at in touched.iter() {
+                plane[at as usize] = NONE;
+            }
+            touched.clear();
         }
     }
 
@@ -216,10 +230,14 @@ impl EdgeCache {
     pub(crate) fn slot(&mut self, i: usize, j: usize, e: usize) -> &mut u32 {
         let lo = CORNERS[EDGES[e][0] as usize];
         let at = (i + lo[0]) + self.nx * (j + lo[1]);
-        match EDGE_AXIS[e] {
-            2 => &mut self.z_edges[at],
-            axis => &mut self.layer_edges[lo[2]][axis][at],
+        let (slot, plane) = match EDGE_AXIS[e] {
+            2 => (&mut self.z_edges[at], 4),
+            axis => (&mut self.layer_edges[lo[2]][axis][at], 2 * lo[2] + axis),
+        };
+        if *slot == NONE {
+            self.touched[plane].push(at as u32);
         }
+        slot
     }
 }
 
@@ -348,25 +366,99 @@ fn for_each_crossed_cell_in(
     let mut cache = EdgeCache::new(nx, ny);
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let first = layers.start;
+    let mut below = LayerSigns::new(grid);
+    let mut above = LayerSigns::new(grid);
+    below.read(values, grid, iso, first);
     for k in layers {
         if k > first {
             cache.advance();
+            std::mem::swap(&mut below, &mut above);
         }
+        above.read(values, grid, iso, k + 1);
         for j in 0..cy {
-            for i in 0..cx {
+            below.for_each_mixed_cell(&above, j, cx, |i| {
                 let base = grid.index(i, j, k);
                 let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - iso);
                 let mut case = 0u8;
                 for (c, &v) in d.iter().enumerate() {
                     case |= ((v < 0.0) as u8) << c;
                 }
-                if case != 0 && case != 255 {
-                    visit([i, j, k], case, &d, &mut cache);
-                }
-            }
+                visit([i, j, k], case, &d, &mut cache);
+            });
         }
     }
     cache
+}
+
+/// Bit `b` set where `values[b] - iso < 0`, for up to 64 values. The comparisons go to a byte
+/// each, which vectorises, and each 8 bytes of 0/1 become 8 bits in one multiplication: byte `i`
+/// times the constant's byte `7 - i` (2^i) lands in bit `56 + i` and nothing else reaches the top
+/// byte.
+fn inside_bits(values: &[f32], iso: f32) -> u64 {
+    let mut flags = [0u8; 64];
+    for (flag, &v) in flags.iter_mut().zip(values) {
+        *flag = ((v - iso) < 0.0) as u8;
+    }
+    flags.chunks_exact(8).enumerate().fold(0, |word, (group, bytes)| {
+        let bytes = u64::from_le_bytes(bytes.try_into().expect("eight bytes"));
+        word | (bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * group)
+    })
+}
+
+/// Which points of one point layer are inside (`value - iso < 0`, the test that sets a cell's
+/// case bits), one bit per point, rows of `words` 64-bit words. Most cells of a grid are far from
+/// the level; with the signs as bits a row of 64 cells is found empty in a few word operations,
+/// and only the cells the level crosses read their eight values.
+struct LayerSigns {
+    words: usize,
+    bits: Vec<u64>,
+}
+
+impl LayerSigns {
+    fn new(grid: &Grid) -> Self {
+        let [nx, ny, _] = grid.points();
+        let words = nx.div_ceil(64);
+        LayerSigns { words, bits: vec![0; words * ny] }
+    }
+
+    /// Reads point layer `k`.
+    fn read(&mut self, values: &[f32], grid: &Grid, iso: f32, k: usize) {
+        let [nx, ny, _] = grid.points();
+        let layer = &values[grid.index(0, 0, k)..][..nx * ny];
+        for (row, bits) in layer.chunks_exact(nx).zip(self.bits.chunks_exact_mut(self.words)) {
+            for (chunk, word) in row.chunks(64).zip(bits.iter_mut()) {
+                *word = inside_bits(chunk, iso);
+            }
+        }
+    }
+
+    fn row(&self, j: usize) -> &[u64] {
+        &self.bits[j * self.words..(j + 1) * self.words]
+    }
+
+    /// Calls `visit(i)`, in increasing `i < cx`, for each cell of row `j` between this layer and
+    /// `above` whose eight corners are not all on one side.
+    fn for_each_mixed_cell(&self, above: &LayerSigns, j: usize, cx: usize, mut visit: impl FnMut(usize)) {
+        let rows = [self.row(j), self.row(j + 1), above.row(j), above.row(j + 1)];
+        let all = |w: usize| if w < self.words { rows.iter().fold(!0, |a, r| a & r[w]) } else { 0 };
+        let any = |w: usize| if w < self.words { rows.iter().fold(0, |a, r| a | r[w]) } else { 0 };
+        for w in 0..self.words {
+            // Point bit b is corner x of cell b; the cell's other x corner is bit b + 1, the next
+            // word's bit 0 for b = 63.
+            let (all_here, any_here) = (all(w), any(w));
+            let all_in = all_here & (all_here >> 1 | all(w + 1) << 63);
+            let any_in = any_here | any_here >> 1 | any(w + 1) << 63;
+            let mut mixed = any_in & !all_in;
+            let first = w * 64;
+            if cx - first < 64 {
+                mixed &= (1u64 << (cx - first)) - 1;
+            }
+            while mixed != 0 {
+                visit(first + mixed.trailing_zeros() as usize);
+                mixed &= mixed - 1;
+            }
+        }
+    }
 }
 
 /// The vertex on cell edge `e` of `cell` (values `d`): looked up in the cache, or placed by
@@ -530,12 +622,21 @@ pub(crate) fn untangled(poly: &[u8], group: &[u8], at: impl Fn(u8) -> Vec3) -> O
     if group.contains(&CENTER) || group.len() <= 3 {
         return None;
     }
-    let tris: Vec<([u32; 3], [DVec3; 3])> = group
-        .chunks_exact(3)
-        .map(|t| ([t[0], t[1], t[2]].map(u32::from), [t[0], t[1], t[2]].map(|e| at(e).as_dvec3())))
-        .collect();
-    any_pair_crosses(&tris)
-        .then(|| (0..poly.len()).flat_map(|k| [CENTER, poly[k], poly[(k + 1) % poly.len()]]).collect())
+    let triangle =
+        |t: &[u8]| ([t[0], t[1], t[2]].map(u32::from), [t[0], t[1], t[2]].map(|e| at(e).as_dvec3()));
+    // Polygons of Marching Cubes' tables have at most 12 vertices (10 triangles): on the stack, as
+    // this runs for every polygon of every crossed cell.
+    let mut stack = [([0u32; 3], [DVec3::ZERO; 3]); 12];
+    let count = group.len() / 3;
+    let crosses = if count <= stack.len() {
+        for (slot, t) in stack.iter_mut().zip(group.chunks_exact(3)) {
+            *slot = triangle(t);
+        }
+        any_pair_crosses(&stack[..count])
+    } else {
+        any_pair_crosses(&group.chunks_exact(3).map(triangle).collect::<Vec<_>>())
+    };
+    crosses.then(|| (0..poly.len()).flat_map(|k| [CENTER, poly[k], poly[(k + 1) % poly.len()]]).collect())
 }
 
 /// Do two of `tris` (ids, corners) cross, by the self-intersection checker's rules?
@@ -592,6 +693,43 @@ pub(crate) fn joined_faces(case: u8, d: &[f32; 8]) -> u8 {
 #[cfg(test)]
 mod slab_tests {
     use super::*;
+
+    /// The sign-bit scan visits exactly the cells whose eight corners are not all on one side, in
+    /// sweep order, with their cases: on random grids whose rows end on, before and after a word
+    /// boundary, with values on the level itself among them.
+    #[test]
+    fn the_sign_bit_scan_visits_every_mixed_cell_and_no_other() {
+        let mut rng = crate::expr::testutil::Rng::new(11);
+        for nx in [2, 3, 63, 64, 65, 66, 127, 128, 129, 200] {
+            let points = [nx, 2 + rng.below(5), 2 + rng.below(5)];
+            let grid = Grid::from_points(points, Vec3::ZERO, Vec3::ONE).unwrap();
+            // Mostly one sign, so whole words are skipped; a few points on the level exactly.
+            let values: Vec<f32> = (0..grid.point_count())
+                .map(|_| match rng.below(8) {
+                    0 => -1.0,
+                    1 => 0.25,
+                    _ => 1.0 + rng.range(0.0, 1.0),
+                })
+                .collect();
+            let iso = 0.25;
+            let mut visited = Vec::new();
+            for_each_crossed_cell(&values, &grid, iso, |ijk, case, _, _| visited.push((ijk, case)));
+            let mut expected = Vec::new();
+            for k in 0..grid.cells[2] {
+                for j in 0..grid.cells[1] {
+                    for i in 0..grid.cells[0] {
+                        let d = cell_values(&values, &grid, iso, [i, j, k]);
+                        let case = d.iter().enumerate().fold(0u8, |c, (n, &v)| c | ((v < 0.0) as u8) << n);
+                        if case != 0 && case != 255 {
+                            expected.push(([i, j, k], case));
+                        }
+                    }
+                }
+            }
+            assert!(!expected.is_empty(), "nx {nx}: no mixed cells to find");
+            assert_eq!(visited, expected, "nx {nx}");
+        }
+    }
 
     /// The slabs joined are exactly one sweep over the whole grid (see [`extract`]), on tall random
     /// grids of several slabs, in both topologies, with one thread or several.
