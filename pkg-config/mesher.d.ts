@@ -50,6 +50,11 @@ export interface Mesher {
   analyzeMesh(result: MeshResult, options?: AnalyzeOptions, control?: CallControl): Promise<MeshAnalysis>;
   /** The mesh as file bytes (the arrays of `result` are copied to the worker, not transferred). */
   exportMesh(result: MeshResult, format: ExportFormat, control?: CallControl): Promise<Uint8Array<ArrayBuffer>>;
+  /**
+   * Threads the worker meshes on: more than 1 where the page is cross-origin isolated and the
+   * package's threaded build (threads/) loaded beside the worker script, else 1.
+   */
+  threadCount(control?: CallControl): Promise<number>;
   /** Calls in flight: the running one and those waiting. */
   readonly busy: number;
   /** Whether cancel() stops a running call at its next checkpoint (the page is cross-origin isolated). */
@@ -63,9 +68,11 @@ export interface Mesher {
 /**
  * A mesher with its own worker. `workerUrl` overrides where the worker script is loaded from;
  * `staleMs` (default 250) is how long a cancelled call may keep running before its worker is
- * replaced.
+ * replaced; `threads` (default 0: one per core, at most 8) is how many threads the worker may
+ * mesh on where the page is cross-origin isolated (1: never more than one). The mesh is the same
+ * for every count.
  */
-export function createMesher(options?: { workerUrl?: string | URL; staleMs?: number }): Mesher;
+export function createMesher(options?: { workerUrl?: string | URL; staleMs?: number; threads?: number }): Mesher;
 
 /**
  * The mesher over workers made by `spawn()` (anything with `onmessage`, `onerror`, `postMessage`
@@ -74,5 +81,5 @@ export function createMesher(options?: { workerUrl?: string | URL; staleMs?: num
  */
 export function createMesherWith(
   spawn: () => Pick<Worker, "postMessage" | "terminate" | "onmessage" | "onerror">,
-  options?: { staleMs?: number; shared?: boolean },
+  options?: { staleMs?: number; shared?: boolean; threads?: number },
 ): Mesher;

@@ -25,13 +25,13 @@ const CANCELLED = 'meshing cancelled';
 /** The arrays of a result the worker reads: the rest (stats, feature lines) is not copied there. */
 const meshArrays = ({ positions, normals, indices }) => ({ positions, normals, indices });
 
-export function createMesher({ workerUrl, staleMs } = {}) {
+export function createMesher({ workerUrl, staleMs, threads } = {}) {
   // Bundlers (Vite, webpack, Parcel) find and emit the worker script only from this literal form.
   const spawn = () => (workerUrl
     ? new Worker(workerUrl, { type: 'module' })
     : new Worker(new URL('./mesher-worker.js', import.meta.url), { type: 'module' }));
   const shared = globalThis.crossOriginIsolated === true && typeof SharedArrayBuffer === 'function';
-  return createMesherWith(spawn, { staleMs, shared });
+  return createMesherWith(spawn, { staleMs, shared, threads });
 }
 
 /**
@@ -39,7 +39,7 @@ export function createMesher({ workerUrl, staleMs } = {}) {
  * and `terminate`, as a Web Worker has); `shared` says whether it may share a SharedArrayBuffer
  * with them. For the Node entry (mesher-node.js); pages use createMesher.
  */
-export function createMesherWith(spawn, { staleMs = 250, shared = false } = {}) {
+export function createMesherWith(spawn, { staleMs = 250, shared = false, threads = 0 } = {}) {
   let worker = null;
   let nextId = 1;
   /** Calls not yet sent, oldest first: { id, name, args, resolve, reject, onProgress }. */
@@ -52,7 +52,7 @@ export function createMesherWith(spawn, { staleMs = 250, shared = false } = {}) 
 
   const start = () => {
     worker = spawn();
-    if (cancelFlag) worker.postMessage({ cancelFlag: cancelFlag.buffer });
+    worker.postMessage({ setup: { cancelFlag: cancelFlag?.buffer, threads } });
     worker.onmessage = ({ data: { id, result, error, progress } }) => {
       const job = running;
       if (!job || job.id !== id) return;
@@ -139,6 +139,7 @@ export function createMesherWith(spawn, { staleMs = 250, shared = false } = {}) 
     meshGrid: (values, dims, bounds, options, control) => call('meshGrid', [values, dims, bounds, options], control),
     analyzeMesh: (result, options, control) => call('analyzeMesh', [meshArrays(result), options], control),
     exportMesh: (result, format, control) => call('exportMesh', [meshArrays(result), format], control),
+    threadCount: (control) => call('threadCount', [], control),
     /** Calls in flight: the running one and those waiting. */
     get busy() { return queue.length + (running && !running.abandoned ? 1 : 0); },
     /** Whether a running call can be stopped at once (shared memory), rather than left to finish. */

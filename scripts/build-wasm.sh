@@ -14,6 +14,14 @@ wasm-bindgen --target web --out-dir pkg "$wasm"
 # No wasm-opt pass: Debian's binaryen (108) predates the reference-types output of current rustc
 # and produces a module that fails at instantiation ("Table.set(): Argument 1 is invalid").
 cp pkg-config/package.json pkg-config/README.md pkg/ 2>/dev/null || true
+
+# The threaded build beside it, which the mesher worker loads on cross-origin-isolated pages.
+log "building the threaded variant into pkg/threads/"
+if wasm_threads_cargo build --release --lib --no-default-features --features threads; then
+  wasm-bindgen --target web --out-dir pkg/threads "$WASM_THREADS_TARGET_DIR/$WASM_TARGET/release/isoforge.wasm"
+else
+  log "no threaded build on this toolchain: pages mesh on one thread"
+fi
 # The plain-JavaScript parts, shipped as they are (and so also in www/pkg): the CSG builder
 # ("isoforge/csg"), the worker mesher ("isoforge/mesher") and the three.js helpers ("isoforge/three").
 cp pkg-config/*.js pkg-config/*.d.ts pkg/

@@ -31,6 +31,28 @@ wasm_cargo() {
   fi
 }
 
+# The threaded build (feature `threads`, pkg/threads/): std rebuilt with atomics, shared memory
+# imported so that Web Workers can share it, and the TLS exports wasm-bindgen's thread start-up
+# needs. It has a target dir of its own, as its std differs from the plain build's.
+WASM_THREADS_RUSTFLAGS="-C target-feature=+atomics,+bulk-memory,+simd128 -C link-arg=--shared-memory \
+-C link-arg=--max-memory=4294967296 -C link-arg=--import-memory -C link-arg=--export=__wasm_init_tls \
+-C link-arg=--export=__tls_size -C link-arg=--export=__tls_align -C link-arg=--export=__tls_base"
+WASM_THREADS_TARGET_DIR="$ROOT/target/wasm-threads"
+
+# wasm_threads_cargo SUBCOMMAND [ARGS...]: cargo for the threaded build. Rebuilding std needs
+# -Z build-std, so it runs only where Debian's toolchain is used (or RUSTC_BOOTSTRAP is allowed);
+# returns 2 where rustup's wasm32 target is used instead, and the package then ships without it.
+wasm_threads_cargo() {
+  local sub="$1"
+  shift
+  if rustup_has_wasm; then
+    return 2
+  fi
+  PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+    RUSTFLAGS="$WASM_THREADS_RUSTFLAGS" CARGO_TARGET_DIR="$WASM_THREADS_TARGET_DIR" \
+    /usr/bin/cargo "$sub" --target "$WASM_TARGET" -Z build-std=std,panic_abort "$@"
+}
+
 # The exact wasm-bindgen version the crate links against; the CLI must match it.
 wasm_bindgen_version() {
   awk '/^name = "wasm-bindgen"$/ { getline; gsub(/version = |"/, ""); print; exit }' "$ROOT/Cargo.lock"

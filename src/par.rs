@@ -1,5 +1,7 @@
-//! Data parallelism where the platform has threads: natively on rayon's pool, in wasm (one thread,
-//! no shared memory) as the same loops run in order.
+//! Data parallelism where the platform has threads: natively on rayon's pool; in wasm built with
+//! the `threads` feature on rayon's pool of Web Workers (started from JavaScript by
+//! `initThreadPool`); in the plain wasm build (one thread, no shared memory) as the same loops
+//! run in order.
 //!
 //! Every parallel section hands out pieces of work (slabs of a grid, chunks of a list) whose
 //! results are put together in the pieces' order, and either the cut never depends on the number
@@ -9,17 +11,40 @@
 //! Progress checkpoints ([`crate::progress`]) are thread-local: the callers keep them outside the
 //! closures given here, between parallel sections, on the job's own thread.
 
-/// `f(0), f(1), …, f(n - 1)`, in that order, computed in parallel where there are threads.
-pub fn map<R: Send>(n: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+#[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+use rayon::prelude::*;
+
+/// Whether the parallel sections go to rayon: always natively; in the threaded wasm build once
+/// [`pool_started`] (rayon's global pool would otherwise try to spawn its own threads there, which
+/// wasm cannot); the plain wasm build has no rayon.
+#[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+fn pooled() -> bool {
     #[cfg(not(target_arch = "wasm32"))]
     {
-        use rayon::prelude::*;
-        (0..n).into_par_iter().map(f).collect()
+        true
     }
-    #[cfg(target_arch = "wasm32")]
+    #[cfg(all(target_arch = "wasm32", feature = "threads"))]
     {
-        (0..n).map(f).collect()
+        POOL_STARTED.load(std::sync::atomic::Ordering::Acquire)
     }
+}
+
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+static POOL_STARTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Records that rayon's global pool runs on Web Workers (`startThreads` in [`crate::wasm`]).
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+pub fn pool_started() {
+    POOL_STARTED.store(true, std::sync::atomic::Ordering::Release);
+}
+
+/// `f(0), f(1), …, f(n - 1)`, in that order, computed in parallel where there are threads.
+pub fn map<R: Send>(n: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+    if pooled() {
+        return (0..n).into_par_iter().map(f).collect();
+    }
+    (0..n).map(f).collect()
 }
 
 /// Calls `f(chunk_index, chunk)` for each `chunk_len`-long piece of `data` (the last may be
@@ -29,27 +54,20 @@ pub fn map_chunks_mut<T: Send, R: Send>(
     chunk_len: usize,
     f: impl Fn(usize, &mut [T]) -> R + Sync + Send,
 ) -> Vec<R> {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        use rayon::prelude::*;
-        data.par_chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect()
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+    if pooled() {
+        return data.par_chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect();
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        data.chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect()
-    }
+    data.chunks_mut(chunk_len).enumerate().map(|(i, c)| f(i, c)).collect()
 }
 
 /// `(a(), b())`, the two on different threads where there are threads to spare.
 pub fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        rayon::join(a, b)
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+    if pooled() {
+        return rayon::join(a, b);
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        (a(), b())
-    }
+    (a(), b())
 }
 
 /// How long the pieces of `total` items are to be cut: one piece where there is one thread (no
@@ -63,16 +81,14 @@ pub fn piece_len(total: usize, min: usize) -> usize {
     }
 }
 
-/// Threads the parallel sections can use (1 in wasm).
+/// Threads the parallel sections can use (1 in the plain wasm build, and in the threaded one
+/// before its pool is started).
 pub fn threads() -> usize {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        rayon::current_num_threads()
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+    if pooled() {
+        return rayon::current_num_threads();
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        1
-    }
+    1
 }
 
 /// Sets how many threads the parallel sections use from now on, for the whole process (the

@@ -28,6 +28,26 @@ fn start() {
     console_error_panic_hook::set_once();
 }
 
+/// Threads the meshing functions run on: 1 in the plain build; in the threaded one (`threads/`,
+/// shared memory) the size of the pool [`start_threads`] started, or 1 before that.
+#[wasm_bindgen(js_name = threadCount)]
+pub fn thread_count() -> usize {
+    crate::par::threads()
+}
+
+/// Starts `threads` Web Workers that the meshing functions' parallel sections (sampling, slabs,
+/// batches) then share; resolves once they run. Only in the threaded build, and only where the
+/// page is cross-origin isolated (`SharedArrayBuffer`); the meshes are the same as on one thread.
+/// `createMesher` calls it in its worker where it can.
+#[cfg(feature = "threads")]
+#[wasm_bindgen(js_name = startThreads)]
+pub fn start_threads(threads: usize) -> js_sys::Promise {
+    let started = Closure::once(|_: JsValue| crate::par::pool_started());
+    let promise = wasm_bindgen_rayon::init_thread_pool(threads.max(1)).then(&started);
+    started.forget();
+    promise
+}
+
 thread_local! {
     static PROGRESS_HOOK: std::cell::RefCell<Option<js_sys::Function>> = const { std::cell::RefCell::new(None) };
 }

@@ -153,3 +153,41 @@ test('an aborted signal rejects a waiting call without touching the running one'
   });
   assert.deepEqual(out, { first: 'fulfilled', second: 'AbortError', made: 1 });
 });
+
+test('on an isolated page the worker meshes on a pool of threads, and the meshes are those of one thread', async () => {
+  const out = await inMesherPage(isolated, async (createMesher) => {
+    const runs = {};
+    for (const threads of [0, 1]) {
+      const mesher = createMesher({ threads });
+      const count = await mesher.threadCount();
+      const meshes = [];
+      for (const [name, options] of [['gear', { method: 'emc', res: 48 }], ['gear', { method: 'mc', res: 64 }],
+        ['rocket', { method: 'dmc', res: 32 }]]) {
+        const r = await mesher.meshScene(name, options);
+        meshes.push({ positions: Array.from(r.positions), indices: Array.from(r.indices) });
+      }
+      mesher.terminate();
+      runs[threads] = { count, meshes };
+    }
+    return { cores: navigator.hardwareConcurrency, runs };
+  });
+  assert.equal(out.runs[1].count, 1, 'threads: 1 keeps to the plain build');
+  assert.equal(out.runs[0].count, Math.min(8, out.cores), 'one thread per core');
+  if (out.cores > 1) assert.ok(out.runs[0].count > 1);
+  out.runs[0].meshes.forEach((mesh, i) => {
+    assert.ok(mesh.indices.length > 0, `mesh ${i} is empty`);
+    assert.deepEqual(mesh, out.runs[1].meshes[i], `mesh ${i} differs between thread counts`);
+  });
+});
+
+test('without cross-origin isolation the worker meshes on one thread', async () => {
+  const out = await inMesherPage(plain, async (createMesher) => {
+    const mesher = createMesher();
+    const count = await mesher.threadCount();
+    const r = await mesher.meshScene('torus', { method: 'emc', res: 24 });
+    mesher.terminate();
+    return { count, triangles: r.stats.triangles };
+  });
+  assert.equal(out.count, 1);
+  assert.ok(out.triangles > 0);
+});
