@@ -68,6 +68,40 @@ pub fn run<D: Domain>(tape: &Tape, inputs: [D; 3], mut observe: impl FnMut(Binar
     }
 }
 
+/// The derivative of unary `op` at `x`, where its value is `v`: every dual evaluator (points and
+/// columns) scales the gradient by this one, so they agree bit for bit.
+#[inline]
+pub(super) fn unary_slope(op: UnaryOp, x: f32, v: f32) -> f32 {
+    match op {
+        UnaryOp::Neg => -1.0,
+        UnaryOp::Abs => {
+            if x < 0.0 {
+                -1.0
+            } else {
+                1.0
+            }
+        }
+        UnaryOp::Sqrt => {
+            if v > 0.0 {
+                0.5 / v
+            } else {
+                0.0
+            }
+        }
+        UnaryOp::Sin => x.cos(),
+        UnaryOp::Cos => -x.sin(),
+        UnaryOp::Tan => 1.0 + v * v,
+        UnaryOp::Asin => 1.0 / (1.0 - x * x).sqrt(),
+        UnaryOp::Acos => -1.0 / (1.0 - x * x).sqrt(),
+        UnaryOp::Atan => 1.0 / (1.0 + x * x),
+        UnaryOp::Exp => v,
+        UnaryOp::Ln => 1.0 / x,
+        UnaryOp::Floor | UnaryOp::Sign => 0.0,
+        UnaryOp::Powi(0) => 0.0,
+        UnaryOp::Powi(n) => n as f32 * ops::powi(x, n - 1),
+    }
+}
+
 /// A value with its gradient with respect to (x, y, z).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Dual {
@@ -90,36 +124,7 @@ impl Domain for Dual {
 
     fn unary(op: UnaryOp, a: Dual) -> Dual {
         let v = ops::unary(op, a.v);
-        let x = a.v;
-        let slope = match op {
-            UnaryOp::Neg => -1.0,
-            UnaryOp::Abs => {
-                if x < 0.0 {
-                    -1.0
-                } else {
-                    1.0
-                }
-            }
-            UnaryOp::Sqrt => {
-                if v > 0.0 {
-                    0.5 / v
-                } else {
-                    0.0
-                }
-            }
-            UnaryOp::Sin => x.cos(),
-            UnaryOp::Cos => -x.sin(),
-            UnaryOp::Tan => 1.0 + v * v,
-            UnaryOp::Asin => 1.0 / (1.0 - x * x).sqrt(),
-            UnaryOp::Acos => -1.0 / (1.0 - x * x).sqrt(),
-            UnaryOp::Atan => 1.0 / (1.0 + x * x),
-            UnaryOp::Exp => v,
-            UnaryOp::Ln => 1.0 / x,
-            UnaryOp::Floor | UnaryOp::Sign => 0.0,
-            UnaryOp::Powi(0) => 0.0,
-            UnaryOp::Powi(n) => n as f32 * ops::powi(x, n - 1),
-        };
-        Dual { v, d: a.d * slope }
+        Dual { v, d: a.d * unary_slope(op, a.v, v) }
     }
 
     fn binary(op: BinaryOp, a: Dual, b: Dual) -> Dual {
