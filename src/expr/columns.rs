@@ -160,13 +160,13 @@ fn run_dual_column(instr: &Instr, cols: &mut [DualColumn]) {
     /// `o.v = value(a.v)` and `o.d = a.d * slope(a.v, o.v)` on every lane.
     fn unary(o: &mut DualColumn, a: &DualColumn, op: UnaryOp) {
         let mut slope = [0.0; LANES];
-        for l in 0..LANES {
-            o.v[l] = ops::unary(op, a.v[l]);
-            slope[l] = unary_slope(op, a.v[l], o.v[l]);
+        for ((ov, s), &av) in o.v.iter_mut().zip(&mut slope).zip(&a.v) {
+            *ov = ops::unary(op, av);
+            *s = unary_slope(op, av, *ov);
         }
         for (od, ad) in o.d.iter_mut().zip(&a.d) {
-            for l in 0..LANES {
-                od[l] = ad[l] * slope[l];
+            for ((od, ad), s) in od.iter_mut().zip(ad).zip(&slope) {
+                *od = ad * s;
             }
         }
     }
@@ -178,12 +178,13 @@ fn run_dual_column(instr: &Instr, cols: &mut [DualColumn]) {
         value: impl Fn(f32, f32) -> f32,
         grad: impl Fn(f32, f32, f32, f32, f32) -> f32,
     ) {
-        for l in 0..LANES {
-            o.v[l] = value(a.v[l], b.v[l]);
+        for (ov, (&av, &bv)) in o.v.iter_mut().zip(a.v.iter().zip(&b.v)) {
+            *ov = value(av, bv);
         }
-        for axis in 0..3 {
-            for l in 0..LANES {
-                o.d[axis][l] = grad(a.v[l], a.d[axis][l], b.v[l], b.d[axis][l], o.v[l]);
+        for ((od, ad), bd) in o.d.iter_mut().zip(&a.d).zip(&b.d) {
+            let lanes = od.iter_mut().zip(ad).zip(bd).zip(a.v.iter().zip(&b.v).zip(&o.v));
+            for (((od, &ad), &bd), ((&av, &bv), &v)) in lanes {
+                *od = grad(av, ad, bv, bd, v);
             }
         }
     }
