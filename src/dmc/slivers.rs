@@ -1,13 +1,27 @@
-//! Sliver collapse (§4 of the paper, in the form that needs no restricted QEF): a crossing that
-//! root finding put within [`SNAP`] of a finest cell of one of its dual edge's ends is moved onto
-//! that end, and all crossings moved onto one dual vertex become one mesh vertex. The triangles
-//! between them shrink to nothing and are dropped; what they were is the fan of slivers Marching
-//! Cubes makes around a dual vertex that lies almost on the surface (a crease vertex, most often).
+//! Slivers, spikes and specks: the bad triangles Marching Cubes makes in the dual cells, removed in
+//! two steps.
 //!
-//! A dual vertex that close to the surface is within `SNAP` cells of it, so the distance bound
-//! moves by at most that much. Collapsing can join two sheets that pass on either side of one
-//! vertex (a wall thinner than `2 * SNAP` cells); the contour's topology is compared before and
-//! after, and where it changed, nothing is collapsed.
+//! **Why they arise.** Every mesh vertex is a root of the field on a dual edge, so where it falls
+//! is the surface's business, not the octree's. A dual vertex on a crease lies *on* the surface
+//! (the QEF puts it there), and every crossing on its dual edges crowds around it; two crossings on
+//! edges of different dual vertices can land a hair apart; and Marching Cubes' fixed triangulation
+//! of each cell then makes a sliver, or a triangle too small to have a meaningful normal that
+//! stands across a crease (a spike), whatever the dual vertices' positions. Restricting the QEF
+//! (vertices exactly on the level) only moves the crowding onto the vertex: the first step below
+//! does that on the mesh, where it can be checked.
+//!
+//! 1. [`collapse`] (§4 of the paper, in the form that needs no restricted QEF): a crossing within
+//!    [`SNAP`] of a finest cell of one of its dual edge's ends moves onto that end, and all
+//!    crossings moved onto one dual vertex become one mesh vertex; the fan of slivers between them
+//!    goes. A dual vertex that close to the surface is within `SNAP` cells of it, so the distance
+//!    bound moves by at most that much. Collapsing can join two sheets that pass on either side of
+//!    one vertex (a wall thinner than `2 * SNAP` cells); the contour's topology is compared before
+//!    and after, and where it changed, nothing is collapsed.
+//! 2. [`improve`]: what is left, removed by edge collapses and flips, each checked before it is
+//!    made to keep the topology, the surface's shape and distance, and the absence of crossings
+//!    (see there). This is a repair pass, bounded ([`PASSES`]) and measured
+//!    ([`super::DmcStats::improved`]); it cannot be avoided by placing the dual vertices
+//!    differently, for the reason above.
 
 use super::contour::{Contour, DualVertices};
 use crate::mesh::analysis;
@@ -358,7 +372,8 @@ impl Work<'_> {
         if common.len() != 2 || !opposite.clone().all(|v| common.contains(&v)) {
             return None;
         }
-        if opposite.clone().any(|v| self.neighbours(v).len() <= 3) || na.len() + nb.len() <= 8 {
+        // The vertex left has |na ∪ nb| - 2 = na + nb - 4 neighbours; each opposite one, one fewer.
+        if opposite.clone().any(|v| self.neighbours(v).len() <= 3) || na.len() + nb.len() < 7 {
             return None;
         }
         let moved = self.faces_of[b as usize].iter().map(|&f| {
@@ -433,21 +448,16 @@ impl Work<'_> {
 /// flipping them: slivers (an angle under [`SLIVER_DEG`]), spikes (turned more than
 /// [`SPIKE_DEG`] from the surface at every corner) and specks (an edge under [`SHORT_EDGE`]).
 ///
-/// **Why a repair, and why it cannot be avoided by placing vertices.** The mesh's vertices are
-/// roots of the field on dual edges, so where they fall is the surface's business, not the
-/// octree's: a crossing can land arbitrarily close to a dual vertex or to another crossing (a
-/// vertex on a crease lies *on* the surface, and every crossing on its edges crowds around it),
-/// and Marching Cubes' fixed triangulation of each cell then makes a sliver, whatever the dual
-/// vertices' positions. [`collapse`] joins the crossings that crowd onto one dual vertex; this
-/// pass removes what is left, on the mesh, with no vertex moved (every vertex stays a root).
+/// No vertex moves: every one stays where root finding (or [`collapse`]) put it. Why this repair
+/// cannot be avoided by placing the dual vertices differently: see the module docs.
 ///
 /// **Why it is safe.** Every change is checked before it is made: collapses only under the link
 /// condition (so the surface keeps its topology and stays a closed manifold), flips only to an edge
 /// not already there; the new triangles must leave fewer bad ones than the old (or as many with a
 /// larger worst angle), lie along the surface (within [`MAX_TURN_DEG`] of the true normal at a
-/// corner, or no worse than the worst triangle they replace), stay within the tolerance of the surface (or no farther than the old
-/// ones), and neither cross nor fold onto any triangle nearby (the analysis's exact tests, on the
-/// triangles in a hash grid of finest cells).
+/// corner, or no worse than the worst triangle they replace), stay within the tolerance of the
+/// surface (or no farther than the old ones), and neither cross nor fold onto any triangle nearby
+/// (the analysis's exact tests, on the triangles in a hash grid of finest cells).
 ///
 /// **Why it is bounded.** At most [`PASSES`] passes over the bad triangles, each change removing
 /// a vertex or replacing two triangles by better ones; the caller reports what it did.
