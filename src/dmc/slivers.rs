@@ -116,15 +116,17 @@ type Corners = [glam::DVec3; 3];
 /// A proposed change: per face, its new corners, or `None` where it goes.
 type Change = Vec<(u32, Option<[u32; 3]>)>;
 
+/// The smallest angle, in degrees: the one opposite the shortest side (one `acos`, not three).
 fn min_angle(c: &Corners) -> f64 {
     let e = [c[1] - c[0], c[2] - c[1], c[0] - c[2]];
-    (0..3)
-        .map(|k| {
-            let (u, v) = (e[k], -e[(k + 2) % 3]);
-            u.cross(v).length().atan2(u.dot(v))
-        })
-        .fold(f64::INFINITY, f64::min)
-        .to_degrees()
+    let shortest =
+        (0..3).min_by(|&i, &j| e[i].length_squared().total_cmp(&e[j].length_squared())).unwrap_or(0);
+    let (u, v) = (-e[(shortest + 1) % 3], e[(shortest + 2) % 3]);
+    let l = (u.length_squared() * v.length_squared()).sqrt();
+    if l == 0.0 {
+        return 0.0;
+    }
+    (u.dot(v) / l).clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 fn normal(c: &Corners) -> glam::DVec3 {
@@ -161,8 +163,10 @@ impl Summary {
 
 struct Work<'a> {
     positions: &'a [glam::Vec3],
-    /// The true unit normal at each mesh vertex (every vertex is a root, on the surface).
+    /// The true unit normal at each mesh vertex (every vertex is a root, on the surface), and the
+    /// gradient's length there.
     normals: Vec<glam::DVec3>,
+    gradient_length: Vec<f32>,
     field: &'a dyn crate::field::Field,
     iso: f32,
     /// Farthest a new triangle may lie from the surface, unless the ones it replaces lay farther.
@@ -193,12 +197,8 @@ impl Work<'_> {
         let deviation = if n == glam::DVec3::ZERO {
             180.0
         } else {
-            t.iter()
-                .map(|&v| {
-                    let g = self.normals[v as usize];
-                    n.cross(g).length().atan2(n.dot(g)).to_degrees()
-                })
-                .fold(180.0, f64::min)
+            let cos = t.iter().map(|&v| self.normals[v as usize].dot(n)).fold(-1.0, f64::max);
+            cos.clamp(-1.0, 1.0).acos().to_degrees()
         };
         let short = (0..3).any(|i| (c[(i + 1) % 3] - c[i]).length() < self.short);
         Shape { angle, deviation, bad: angle < SLIVER_DEG || deviation > SPIKE_DEG || short }
@@ -242,10 +242,10 @@ impl Work<'_> {
     }
 
     /// Whether `change` is an improvement that keeps the surface where it was, and how good: it
-    /// leaves fewer bad triangles, or as many with a larger worst angle; turns no new triangle
-    /// from the surface by more than [`MAX_TURN_DEG`] (or than the worst it replaces); and
-    /// crosses or folds onto nothing. Returns (bad triangles after, worst angle after).
-    fn acceptable(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> Option<(usize, f64)> {
+    /// leaves fewer bad triangles, or as many with a larger worst angle, and turns no new triangle
+    /// from the surface by more than [`MAX_TURN_DEG`] (or than the worst it replaces). Returns
+    /// (bad triangles after, worst angle after).
+    fn better(&self, change: &[(u32, Option<[u32; 3]>)]) -> Option<(usize, f64)> {
         let (mut before, mut after) = (Summary::new(), Summary::new());
         for &(f, t) in change {
             let old = self.triangles[f as usize];
@@ -264,6 +264,12 @@ impl Work<'_> {
         if !(after.bad < before.bad || (after.bad == before.bad && after.angle > before.angle)) {
             return None;
         }
+        Some((after.bad, after.angle))
+    }
+
+    /// Whether no new triangle of `change` crosses or folds onto a triangle nearby (the costly
+    /// part of the checks, asked of the best changes first).
+    fn clear(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
         let mut candidates = Vec::new();
         for &(f, t) in change {
             let Some(t) = t else { continue };
@@ -279,7 +285,7 @@ impl Work<'_> {
             for u in others {
                 let d = self.corners(u);
                 if crate::mesh::analysis::self_intersect::indexed_pair_intersects((t, c), (u, d)) {
-                    return None;
+                    return false;
                 }
                 // Neighbours across an edge: not folded onto each other.
                 let shared: Vec<usize> = (0..3).filter(|&i| u.contains(&t[i])).collect();
@@ -292,25 +298,25 @@ impl Work<'_> {
                         c[3 - i - j] - o,
                         d[x] - o,
                     ) {
-                        return None;
+                        return false;
                     }
                 }
             }
         }
-        Some((after.bad, after.angle))
+        true
     }
 
     /// The first-order distance `|f - iso| / |∇f|` of `t`'s farthest sample, the points
     /// [`crate::mesh::analysis::surface_error()`] measures: the centroid and halfway from it to each
-    /// corner (the corners are roots, on the surface).
+    /// corner (the corners are roots, on the surface), with the gradient's length taken as the
+    /// corners' mean (known already: four values per triangle, no gradient to evaluate).
     fn distance_of(&self, t: [u32; 3]) -> f32 {
         let c = t.map(|v| self.positions[v as usize]);
         let centroid = (c[0] + c[1] + c[2]) / 3.0;
         let points = [centroid, (centroid + c[0]) * 0.5, (centroid + c[1]) * 0.5, (centroid + c[2]) * 0.5];
         let mut values = [0.0; 4];
         self.field.values(&points, &mut values);
-        let step = (c[1] - c[0]).length().max((c[2] - c[0]).length()) * 1e-3;
-        let g = crate::field::gradient_or_differences(self.field, centroid, step.max(1e-6)).length();
+        let g = t.iter().map(|&v| self.gradient_length[v as usize]).sum::<f32>() / 3.0;
         let worst = values.iter().map(|v| (v - self.iso).abs()).fold(0.0, f32::max);
         if g > 0.0 && g.is_finite() {
             worst / g
@@ -320,18 +326,21 @@ impl Work<'_> {
     }
 
     /// Whether the new triangles of `change` lie no farther from the surface than the tolerance,
-    /// or than the triangles they replace.
+    /// or than the triangles they replace (measured only when a new one is beyond the tolerance).
     fn near_surface(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
-        let mut allowed = self.tolerance;
-        for &(f, _) in change {
+        let farthest = change
+            .iter()
+            .filter_map(|&(f, t)| t.filter(|&t| t != self.triangles[f as usize]))
+            .map(|t| self.distance_of(t))
+            .fold(0.0, f32::max);
+        if farthest <= self.tolerance {
+            return true;
+        }
+        change.iter().any(|&(f, _)| {
             if self.distance[f as usize].is_nan() {
                 self.distance[f as usize] = self.distance_of(self.triangles[f as usize]);
             }
-            allowed = allowed.max(self.distance[f as usize]);
-        }
-        change.iter().all(|&(f, t)| match t {
-            Some(t) if t != self.triangles[f as usize] => self.distance_of(t) <= allowed,
-            _ => true,
+            self.distance[f as usize] >= farthest
         })
     }
 
@@ -491,6 +500,7 @@ pub fn improve(
     let mut work = Work {
         positions: &mesh.positions,
         normals: gradients.iter().map(|g| g.as_dvec3().normalize_or_zero()).collect(),
+        gradient_length: gradients.iter().map(|g| g.length()).collect(),
         field,
         iso,
         tolerance,
@@ -529,16 +539,17 @@ pub fn improve(
                     (work.collapse_change(b, a), false),
                 ] {
                     let Some(change) = change else { continue };
-                    if let Some(score) = work.acceptable(&change) {
+                    if let Some(score) = work.better(&change) {
                         options.push((score, change, flip));
                     }
                 }
             }
-            // The best change that stays near the surface (the field is asked last, and only as
-            // far down the list as needed): fewest bad triangles, then the largest worst angle.
+            // The best change that crosses nothing and stays near the surface (the costly checks
+            // asked only as far down the list as needed): fewest bad triangles, then the largest
+            // worst angle.
             options.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(y.0 .1.total_cmp(&x.0 .1)));
             if let Some((_, change, flip)) =
-                options.into_iter().find(|(_, change, _)| work.near_surface(change))
+                options.into_iter().find(|(_, change, _)| work.clear(change) && work.near_surface(change))
             {
                 work.apply(&change);
                 changed += 1;
