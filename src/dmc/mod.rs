@@ -14,7 +14,8 @@
 //! - [`dual`]: the dual cells, one per octree vertex, the grid's boundary included.
 //! - [`contour`]: Marching Cubes on the dual cells, crossings by root finding per dual edge.
 //! - [`slivers`]: crossings within a tenth of a cell of a dual vertex moved onto it, the slivers
-//!   between them dropped.
+//!   between them dropped; then the slivers, spikes and specks left removed by checked edge
+//!   collapses and flips (no vertex moves off the surface, the topology is kept).
 //! - [`untangle`]: vertices of folded or crossing triangles moved toward their leaves' centres,
 //!   keeping their signs (so the topology), in a bounded number of rounds.
 //!
@@ -38,6 +39,7 @@ pub mod contour;
 pub mod dual;
 pub mod fidelity;
 pub mod qef;
+pub mod quality;
 pub mod safety;
 pub mod simplify;
 pub mod slivers;
@@ -137,6 +139,9 @@ pub struct DmcStats {
     pub crossing_triangles: usize,
     pub moved_vertices: usize,
     pub unmerged_leaves: usize,
+    /// What [`slivers::improve`] did to the final contour: collapses, flips, bad triangles
+    /// (slivers, spikes, specks) before and left.
+    pub improved: slivers::Improved,
     pub crust_ms: f64,
     pub sampling_ms: f64,
     pub simplify_ms: f64,
@@ -167,14 +172,16 @@ fn contour_cells(
     keys: &[[dual::VertexKey; 8]],
     field: &dyn Field,
     iso: f32,
+    tolerance: f32,
     cache: &mut contour::RootCache,
-) -> contour::Contour {
+) -> (contour::Contour, slivers::Improved) {
     let mut vertices = DualVertices::default();
     let cells: Vec<[u32; 8]> = keys.iter().map(|cell| cell.map(|k| vertices.id(tree, k))).collect();
     vertices.evaluate(field, iso);
     let mut contour = contour::contour(&cells, &vertices, field, iso, cache);
     slivers::collapse(&mut contour, &vertices, tree.h);
-    contour
+    let improved = slivers::improve(&mut contour, field, iso, tolerance, tree.h);
+    (contour, improved)
 }
 
 /// The finest grid of a DMC run over `[min, max]`: `2^max_depth` cubic cells along the longest
@@ -236,7 +243,7 @@ pub fn mesh_field(
     let mut moves = vec![0u8; tree.nodes.len()];
     let mut origins = rustc_hash::FxHashMap::default();
     let mut roots = contour::RootCache::default();
-    let mut contour = contour_cells(&tree, &keys, field, iso, &mut roots);
+    let (mut contour, mut improved) = contour_cells(&tree, &keys, field, iso, tolerance, &mut roots);
     stats.contour_ms = ms_since(t);
     let t = Instant::now();
     for round in 0..=untangle::ROUNDS {
@@ -260,8 +267,9 @@ pub fn mesh_field(
             dual::for_each_mixed_cell(&tree, |cell| keys.push(*cell));
             stats.dual_cells = keys.len();
         }
-        contour = contour_cells(&tree, &keys, field, iso, &mut roots);
+        (contour, improved) = contour_cells(&tree, &keys, field, iso, tolerance, &mut roots);
     }
+    stats.improved = improved;
     let mut mesh = contour.mesh;
     contour::field_normals(&mut mesh, field, tree.h * 1e-2);
     stats.untangle_ms = ms_since(t);

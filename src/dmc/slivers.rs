@@ -1,13 +1,27 @@
-//! Sliver collapse (§4 of the paper, in the form that needs no restricted QEF): a crossing that
-//! root finding put within [`SNAP`] of a finest cell of one of its dual edge's ends is moved onto
-//! that end, and all crossings moved onto one dual vertex become one mesh vertex. The triangles
-//! between them shrink to nothing and are dropped; what they were is the fan of slivers Marching
-//! Cubes makes around a dual vertex that lies almost on the surface (a crease vertex, most often).
+//! Slivers, spikes and specks: the bad triangles Marching Cubes makes in the dual cells, removed in
+//! two steps.
 //!
-//! A dual vertex that close to the surface is within `SNAP` cells of it, so the distance bound
-//! moves by at most that much. Collapsing can join two sheets that pass on either side of one
-//! vertex (a wall thinner than `2 * SNAP` cells); the contour's topology is compared before and
-//! after, and where it changed, nothing is collapsed.
+//! **Why they arise.** Every mesh vertex is a root of the field on a dual edge, so where it falls
+//! is the surface's business, not the octree's. A dual vertex on a crease lies *on* the surface
+//! (the QEF puts it there), and every crossing on its dual edges crowds around it; two crossings on
+//! edges of different dual vertices can land a hair apart; and Marching Cubes' fixed triangulation
+//! of each cell then makes a sliver, or a triangle too small to have a meaningful normal that
+//! stands across a crease (a spike), whatever the dual vertices' positions. Restricting the QEF
+//! (vertices exactly on the level) only moves the crowding onto the vertex: the first step below
+//! does that on the mesh, where it can be checked.
+//!
+//! 1. [`collapse`] (§4 of the paper, in the form that needs no restricted QEF): a crossing within
+//!    [`SNAP`] of a finest cell of one of its dual edge's ends moves onto that end, and all
+//!    crossings moved onto one dual vertex become one mesh vertex; the fan of slivers between them
+//!    goes. A dual vertex that close to the surface is within `SNAP` cells of it, so the distance
+//!    bound moves by at most that much. Collapsing can join two sheets that pass on either side of
+//!    one vertex (a wall thinner than `2 * SNAP` cells); the contour's topology is compared before
+//!    and after, and where it changed, nothing is collapsed.
+//! 2. [`improve`]: what is left, removed by edge collapses and flips, each checked before it is
+//!    made to keep the topology, the surface's shape and distance, and the absence of crossings
+//!    (see there). This is a repair pass, bounded ([`PASSES`]) and measured
+//!    ([`super::DmcStats::improved`]); it cannot be avoided by placing the dual vertices
+//!    differently, for the reason above.
 
 use super::contour::{Contour, DualVertices};
 use crate::mesh::analysis;
@@ -63,4 +77,503 @@ pub fn collapse(contour: &mut Contour, vertices: &DualVertices, h: f32) -> usize
     contour.mesh = collapsed;
     contour.cell_of_triangle = cells;
     removed
+}
+
+/// Triangles with an angle under this are slivers to remove.
+pub const SLIVER_DEG: f64 = 10.0;
+
+/// A triangle turned from the true normals at all three of its corners by more than this is a
+/// spike (or a notch across a crease) to remove, and no change may make one.
+pub const SPIKE_DEG: f64 = 30.0;
+
+/// Edges shorter than this fraction of a finest cell are removed whatever their triangles' angles:
+/// crossings that root finding put within a hair of each other, on different dual vertices' edges
+/// (so [`collapse`] did not join them), make clusters of triangles too small to see whose normals
+/// are rounding noise.
+pub const SHORT_EDGE: f64 = 0.02;
+
+/// A change is refused if one of its new triangles turns away from the true normals at all its
+/// corners by more than this (and more than the worst triangle it replaces): the new triangles
+/// must lie along the surface, on one side of a crease or the other, never across it.
+pub const MAX_TURN_DEG: f64 = 30.0;
+
+/// Passes over the remaining bad triangles.
+pub const PASSES: usize = 4;
+
+/// What [`improve`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Improved {
+    pub collapses: usize,
+    pub flips: usize,
+    /// Bad triangles (slivers, spikes, specks) before, and left where no allowed change removes
+    /// them.
+    pub bad_before: usize,
+    pub left: usize,
+}
+
+type Corners = [glam::DVec3; 3];
+
+/// A proposed change: per face, its new corners, or `None` where it goes.
+type Change = Vec<(u32, Option<[u32; 3]>)>;
+
+/// The smallest angle, in degrees: the one opposite the shortest side (one `acos`, not three).
+fn min_angle(c: &Corners) -> f64 {
+    let e = [c[1] - c[0], c[2] - c[1], c[0] - c[2]];
+    let shortest =
+        (0..3).min_by(|&i, &j| e[i].length_squared().total_cmp(&e[j].length_squared())).unwrap_or(0);
+    let (u, v) = (-e[(shortest + 1) % 3], e[(shortest + 2) % 3]);
+    let l = (u.length_squared() * v.length_squared()).sqrt();
+    if l == 0.0 {
+        return 0.0;
+    }
+    (u.dot(v) / l).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+fn normal(c: &Corners) -> glam::DVec3 {
+    (c[1] - c[0]).cross(c[2] - c[0]).normalize_or_zero()
+}
+
+/// How one triangle fares: its smallest angle, its turn from the surface, and whether it is bad.
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    angle: f64,
+    deviation: f64,
+    bad: bool,
+}
+
+/// Worst angle, worst deviation and bad triangles over a set of triangles.
+#[derive(Debug, Clone, Copy)]
+struct Summary {
+    angle: f64,
+    deviation: f64,
+    bad: usize,
+}
+
+impl Summary {
+    fn new() -> Summary {
+        Summary { angle: f64::INFINITY, deviation: 0.0, bad: 0 }
+    }
+
+    fn add(&mut self, s: Shape) {
+        self.angle = self.angle.min(s.angle);
+        self.deviation = self.deviation.max(s.deviation);
+        self.bad += s.bad as usize;
+    }
+}
+
+struct Work<'a> {
+    positions: &'a [glam::Vec3],
+    /// The true unit normal at each mesh vertex (every vertex is a root, on the surface), and the
+    /// gradient's length there.
+    normals: Vec<glam::DVec3>,
+    gradient_length: Vec<f32>,
+    field: &'a dyn crate::field::Field,
+    iso: f32,
+    /// Farthest a new triangle may lie from the surface, unless the ones it replaces lay farther.
+    tolerance: f32,
+    /// Shortest edge kept.
+    short: f64,
+    /// Per face, its estimated distance from the surface once measured.
+    distance: Vec<f32>,
+    triangles: Vec<[u32; 3]>,
+    alive: Vec<bool>,
+    faces_of: Vec<Vec<u32>>,
+    fixed: Vec<bool>,
+    grid: rustc_hash::FxHashMap<[i32; 3], Vec<u32>>,
+    cell: f64,
+    seen: Vec<u32>,
+    stamp: u32,
+}
+
+impl Work<'_> {
+    fn corners(&self, t: [u32; 3]) -> Corners {
+        t.map(|v| self.positions[v as usize].as_dvec3())
+    }
+
+    fn shape(&self, t: [u32; 3]) -> Shape {
+        let c = self.corners(t);
+        let angle = min_angle(&c);
+        let n = normal(&c);
+        let deviation = if n == glam::DVec3::ZERO {
+            180.0
+        } else {
+            let cos = t.iter().map(|&v| self.normals[v as usize].dot(n)).fold(-1.0, f64::max);
+            cos.clamp(-1.0, 1.0).acos().to_degrees()
+        };
+        let short = (0..3).any(|i| (c[(i + 1) % 3] - c[i]).length() < self.short);
+        Shape { angle, deviation, bad: angle < SLIVER_DEG || deviation > SPIKE_DEG || short }
+    }
+
+    fn keys(&self, c: &Corners) -> ([i32; 3], [i32; 3]) {
+        let lo = c[0].min(c[1]).min(c[2]);
+        let hi = c[0].max(c[1]).max(c[2]);
+        let k = |p: glam::DVec3| (p / self.cell).floor().as_ivec3().to_array();
+        (k(lo), k(hi))
+    }
+
+    fn insert(&mut self, f: u32) {
+        let (lo, hi) = self.keys(&self.corners(self.triangles[f as usize]));
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    self.grid.entry([x, y, z]).or_default().push(f);
+                }
+            }
+        }
+    }
+
+    /// Live triangles whose boxes' cells meet `c`'s.
+    fn near(&mut self, c: &Corners, out: &mut Vec<u32>) {
+        self.stamp += 1;
+        let (lo, hi) = self.keys(c);
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let Some(list) = self.grid.get(&[x, y, z]) else { continue };
+                    for &f in list {
+                        if self.alive[f as usize] && self.seen[f as usize] != self.stamp {
+                            self.seen[f as usize] = self.stamp;
+                            out.push(f);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether `change` is an improvement that keeps the surface where it was, and how good: it
+    /// leaves fewer bad triangles, or as many with a larger worst angle, and turns no new triangle
+    /// from the surface by more than [`MAX_TURN_DEG`] (or than the worst it replaces). Returns
+    /// (bad triangles after, worst angle after).
+    fn better(&self, change: &[(u32, Option<[u32; 3]>)]) -> Option<(usize, f64)> {
+        let (mut before, mut after) = (Summary::new(), Summary::new());
+        for &(f, t) in change {
+            let old = self.triangles[f as usize];
+            let shape = self.shape(old);
+            if t == Some(old) {
+                continue;
+            }
+            before.add(shape);
+            if let Some(t) = t {
+                after.add(self.shape(t));
+            }
+        }
+        if after.deviation > before.deviation.max(MAX_TURN_DEG) {
+            return None;
+        }
+        if !(after.bad < before.bad || (after.bad == before.bad && after.angle > before.angle)) {
+            return None;
+        }
+        Some((after.bad, after.angle))
+    }
+
+    /// Whether no new triangle of `change` crosses or folds onto a triangle nearby (the costly
+    /// part of the checks, asked of the best changes first).
+    fn clear(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
+        let mut candidates = Vec::new();
+        for &(f, t) in change {
+            let Some(t) = t else { continue };
+            if t == self.triangles[f as usize] {
+                continue;
+            }
+            let c = self.corners(t);
+            candidates.clear();
+            self.near(&c, &mut candidates);
+            candidates.retain(|&g| !change.iter().any(|&(f, _)| f == g));
+            let mut others: Vec<[u32; 3]> = candidates.iter().map(|&g| self.triangles[g as usize]).collect();
+            others.extend(change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t));
+            for u in others {
+                let d = self.corners(u);
+                if crate::mesh::analysis::self_intersect::indexed_pair_intersects((t, c), (u, d)) {
+                    return false;
+                }
+                // Neighbours across an edge: not folded onto each other.
+                let shared: Vec<usize> = (0..3).filter(|&i| u.contains(&t[i])).collect();
+                if shared.len() == 2 {
+                    let (i, j) = (shared[0], shared[1]);
+                    let Some(x) = u.iter().position(|v| !t.contains(v)) else { continue };
+                    let o = c[i];
+                    if crate::mesh::analysis::tri_tri::folded_across_edge(
+                        c[j] - o,
+                        c[3 - i - j] - o,
+                        d[x] - o,
+                    ) {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// The first-order distance `|f - iso| / |∇f|` of `t`'s farthest sample, the points
+    /// [`crate::mesh::analysis::surface_error()`] measures: the centroid and halfway from it to each
+    /// corner (the corners are roots, on the surface), with the gradient's length taken as the
+    /// corners' mean (known already: four values per triangle, no gradient to evaluate).
+    fn distance_of(&self, t: [u32; 3]) -> f32 {
+        let c = t.map(|v| self.positions[v as usize]);
+        let centroid = (c[0] + c[1] + c[2]) / 3.0;
+        let points = [centroid, (centroid + c[0]) * 0.5, (centroid + c[1]) * 0.5, (centroid + c[2]) * 0.5];
+        let mut values = [0.0; 4];
+        self.field.values(&points, &mut values);
+        let g = t.iter().map(|&v| self.gradient_length[v as usize]).sum::<f32>() / 3.0;
+        let worst = values.iter().map(|v| (v - self.iso).abs()).fold(0.0, f32::max);
+        if g > 0.0 && g.is_finite() {
+            worst / g
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// Whether the new triangles of `change` lie no farther from the surface than the tolerance,
+    /// or than the triangles they replace (measured only when a new one is beyond the tolerance).
+    fn near_surface(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
+        let farthest = change
+            .iter()
+            .filter_map(|&(f, t)| t.filter(|&t| t != self.triangles[f as usize]))
+            .map(|t| self.distance_of(t))
+            .fold(0.0, f32::max);
+        if farthest <= self.tolerance {
+            return true;
+        }
+        change.iter().any(|&(f, _)| {
+            if self.distance[f as usize].is_nan() {
+                self.distance[f as usize] = self.distance_of(self.triangles[f as usize]);
+            }
+            self.distance[f as usize] >= farthest
+        })
+    }
+
+    /// The vertices sharing an edge with `v`, sorted (a fan is a few triangles: a linear scan).
+    fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut out = Vec::with_capacity(8);
+        for &f in &self.faces_of[v as usize] {
+            for w in self.triangles[f as usize] {
+                if w != v && !out.contains(&w) {
+                    out.push(w);
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// The change collapsing `b` onto `a` (with `a`'s other triangles, unchanged, for reference),
+    /// if it keeps the surface a closed manifold of the same topology: the link condition (the
+    /// two ends share exactly the two neighbours across the edge), and no vertex left with fewer
+    /// than three neighbours.
+    fn collapse_change(&self, a: u32, b: u32) -> Option<Change> {
+        if self.fixed[a as usize] || self.fixed[b as usize] {
+            return None;
+        }
+        let shared: Vec<u32> = self.faces_of[b as usize]
+            .iter()
+            .copied()
+            .filter(|&f| self.triangles[f as usize].contains(&a))
+            .collect();
+        if shared.len() != 2 {
+            return None;
+        }
+        let (na, nb) = (self.neighbours(a), self.neighbours(b));
+        let common: Vec<u32> = na.iter().copied().filter(|v| nb.binary_search(v).is_ok()).collect();
+        let opposite =
+            shared.iter().filter_map(|&f| self.triangles[f as usize].into_iter().find(|&v| v != a && v != b));
+        if common.len() != 2 || !opposite.clone().all(|v| common.contains(&v)) {
+            return None;
+        }
+        // The vertex left has |na ∪ nb| - 2 = na + nb - 4 neighbours; each opposite one, one fewer.
+        if opposite.clone().any(|v| self.neighbours(v).len() <= 3) || na.len() + nb.len() < 7 {
+            return None;
+        }
+        let moved = self.faces_of[b as usize].iter().map(|&f| {
+            let t = self.triangles[f as usize];
+            (f, (!t.contains(&a)).then(|| t.map(|v| if v == b { a } else { v })))
+        });
+        let kept = self.faces_of[a as usize]
+            .iter()
+            .filter(|&&f| !self.triangles[f as usize].contains(&b))
+            .map(|&f| (f, Some(self.triangles[f as usize])));
+        Some(moved.chain(kept).collect())
+    }
+
+    /// The change flipping the edge `(a, b)` of face `f`, if the new edge is not there already.
+    fn flip_change(&self, f: u32, a: u32, b: u32) -> Option<Change> {
+        if self.fixed[a as usize] || self.fixed[b as usize] {
+            return None;
+        }
+        let t = self.triangles[f as usize];
+        let c = *t.iter().find(|&&v| v != a && v != b)?;
+        let g = *self.faces_of[a as usize]
+            .iter()
+            .find(|&&g| g != f && self.triangles[g as usize].contains(&b))?;
+        let d = *self.triangles[g as usize].iter().find(|&&v| v != a && v != b)?;
+        if c == d || self.neighbours(c).contains(&d) {
+            return None;
+        }
+        // Oriented as f: a -> b -> c.
+        let i = t.iter().position(|&v| v == a)?;
+        let (a, b) = if t[(i + 1) % 3] == b { (a, b) } else { (b, a) };
+        Some(vec![(f, Some([a, d, c])), (g, Some([b, c, d]))])
+    }
+
+    fn apply(&mut self, change: &[(u32, Option<[u32; 3]>)]) {
+        for &(f, t) in change {
+            let old = self.triangles[f as usize];
+            if t == Some(old) {
+                continue;
+            }
+            self.distance[f as usize] = f32::NAN;
+            for v in old {
+                self.faces_of[v as usize].retain(|&g| g != f);
+            }
+            match t {
+                None => self.alive[f as usize] = false,
+                Some(t) => {
+                    self.triangles[f as usize] = t;
+                    for v in t {
+                        self.faces_of[v as usize].push(f);
+                    }
+                    self.insert(f);
+                }
+            }
+        }
+    }
+
+    fn bad_faces(&self) -> Vec<(f64, u32)> {
+        let mut out: Vec<(f64, u32)> = (0..self.triangles.len() as u32)
+            .filter(|&f| self.alive[f as usize])
+            .filter_map(|f| {
+                let s = self.shape(self.triangles[f as usize]);
+                // Worst first: spikes by their turn, then slivers and specks by their angle.
+                s.bad.then_some((s.angle - s.deviation, f))
+            })
+            .collect();
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        out
+    }
+}
+
+/// Removes the bad triangles Marching Cubes leaves in the dual cells, by collapsing edges and
+/// flipping them: slivers (an angle under [`SLIVER_DEG`]), spikes (turned more than
+/// [`SPIKE_DEG`] from the surface at every corner) and specks (an edge under [`SHORT_EDGE`]).
+///
+/// No vertex moves: every one stays where root finding (or [`collapse`]) put it. Why this repair
+/// cannot be avoided by placing the dual vertices differently: see the module docs.
+///
+/// **Why it is safe.** Every change is checked before it is made: collapses only under the link
+/// condition (so the surface keeps its topology and stays a closed manifold), flips only to an edge
+/// not already there; the new triangles must leave fewer bad ones than the old (or as many with a
+/// larger worst angle), lie along the surface (within [`MAX_TURN_DEG`] of the true normal at a
+/// corner, or no worse than the worst triangle they replace), stay within the tolerance of the
+/// surface (or no farther than the old ones), and neither cross nor fold onto any triangle nearby
+/// (the analysis's exact tests, on the triangles in a hash grid of finest cells).
+///
+/// **Why it is bounded.** At most [`PASSES`] passes over the bad triangles, each change removing
+/// a vertex or replacing two triangles by better ones; the caller reports what it did.
+pub fn improve(
+    contour: &mut Contour,
+    field: &dyn crate::field::Field,
+    iso: f32,
+    tolerance: f32,
+    h: f32,
+) -> Improved {
+    let mesh = &contour.mesh;
+    let n = mesh.positions.len();
+    let mut faces_of = vec![Vec::new(); n];
+    let mut edge_count: rustc_hash::FxHashMap<(u32, u32), u32> = Default::default();
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for (i, &v) in t.iter().enumerate() {
+            faces_of[v as usize].push(f as u32);
+            let w = t[(i + 1) % 3];
+            *edge_count.entry((v.min(w), v.max(w))).or_default() += 1;
+        }
+    }
+    let mut fixed = vec![false; n];
+    for (&(a, b), &count) in &edge_count {
+        if count != 2 {
+            fixed[a as usize] = true;
+            fixed[b as usize] = true;
+        }
+    }
+    let (mut scratch, mut gradients) = (Vec::new(), Vec::new());
+    crate::field::gradients_or_differences(field, &mesh.positions, h * 1e-2, &mut scratch, &mut gradients);
+    let mut work = Work {
+        positions: &mesh.positions,
+        normals: gradients.iter().map(|g| g.as_dvec3().normalize_or_zero()).collect(),
+        gradient_length: gradients.iter().map(|g| g.length()).collect(),
+        field,
+        iso,
+        tolerance,
+        short: SHORT_EDGE * h as f64,
+        distance: vec![f32::NAN; mesh.triangles.len()],
+        triangles: mesh.triangles.clone(),
+        alive: vec![true; mesh.triangles.len()],
+        faces_of,
+        fixed,
+        grid: Default::default(),
+        cell: h as f64,
+        seen: vec![0; mesh.triangles.len()],
+        stamp: 0,
+    };
+    for f in 0..work.triangles.len() as u32 {
+        work.insert(f);
+    }
+    let mut out = Improved::default();
+    for pass in 0..PASSES {
+        let bad = work.bad_faces();
+        if pass == 0 {
+            out.bad_before = bad.len();
+        }
+        let mut changed = 0;
+        for &(_, f) in &bad {
+            if !work.alive[f as usize] || !work.shape(work.triangles[f as usize]).bad {
+                continue;
+            }
+            let t = work.triangles[f as usize];
+            let mut options: Vec<((usize, f64), Change, bool)> = Vec::new();
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                for (change, flip) in [
+                    (work.flip_change(f, a, b), true),
+                    (work.collapse_change(a, b), false),
+                    (work.collapse_change(b, a), false),
+                ] {
+                    let Some(change) = change else { continue };
+                    if let Some(score) = work.better(&change) {
+                        options.push((score, change, flip));
+                    }
+                }
+            }
+            // The best change that crosses nothing and stays near the surface (the costly checks
+            // asked only as far down the list as needed): fewest bad triangles, then the largest
+            // worst angle.
+            options.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(y.0 .1.total_cmp(&x.0 .1)));
+            if let Some((_, change, flip)) =
+                options.into_iter().find(|(_, change, _)| work.clear(change) && work.near_surface(change))
+            {
+                work.apply(&change);
+                changed += 1;
+                if flip {
+                    out.flips += 1;
+                } else {
+                    out.collapses += 1;
+                }
+            }
+        }
+        if changed == 0 {
+            break;
+        }
+    }
+    out.left = work.bad_faces().len();
+    let mut triangles = Vec::with_capacity(work.triangles.len());
+    let mut cells = Vec::with_capacity(work.triangles.len());
+    for (f, t) in work.triangles.iter().enumerate() {
+        if work.alive[f] {
+            triangles.push(*t);
+            cells.push(contour.cell_of_triangle[f]);
+        }
+    }
+    contour.mesh.triangles = triangles;
+    contour.cell_of_triangle = cells;
+    out
 }
