@@ -243,7 +243,8 @@ pub fn mesh_with_sampler(
             grid.cell_size(),
         );
     }
-    out.feature_edges = lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex, &centres.crease);
+    out.feature_edges =
+        lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex, &centres.crease, grid.cell_size());
     timings.flip_ms = ms_since(t2);
     Ok((out, timings))
 }
