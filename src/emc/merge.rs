@@ -32,6 +32,7 @@ pub fn merge_flat_crossings(
     mesh: &mut Mesh,
     fan_centre: &mut Vec<bool>,
     feature_vertex: &mut Vec<bool>,
+    crease: &mut Vec<Vec3>,
     h: f32,
 ) -> usize {
     let n = mesh.positions.len();
@@ -62,7 +63,7 @@ pub fn merge_flat_crossings(
         merged += 1;
     }
     if merged > 0 {
-        compact(mesh, [fan_centre, feature_vertex], &removed, &dead);
+        compact(mesh, [fan_centre, feature_vertex], crease, &removed, &dead);
     }
     merged
 }
@@ -136,7 +137,13 @@ fn collapse(mesh: &mut Mesh, incident: &mut [Vec<u32>], dead: &mut [bool], a: u3
 }
 
 /// Drops removed vertices and dead triangles, renumbering what is left.
-fn compact(mesh: &mut Mesh, flags: [&mut Vec<bool>; 2], removed: &[bool], dead: &[bool]) {
+fn compact(
+    mesh: &mut Mesh,
+    flags: [&mut Vec<bool>; 2],
+    crease: &mut Vec<Vec3>,
+    removed: &[bool],
+    dead: &[bool],
+) {
     let mut new_index = vec![u32::MAX; removed.len()];
     let mut next = 0u32;
     for (v, &gone) in removed.iter().enumerate() {
@@ -153,6 +160,7 @@ fn compact(mesh: &mut Mesh, flags: [&mut Vec<bool>; 2], removed: &[bool], dead: 
     for flag in flags {
         *flag = (0..removed.len()).filter(keep).map(|v| flag[v]).collect();
     }
+    *crease = (0..removed.len()).filter(keep).map(|v| crease[v]).collect();
     let triangles = std::mem::take(&mut mesh.triangles);
     mesh.triangles = triangles
         .into_iter()
@@ -205,7 +213,10 @@ mod tests {
         let mut centre = vec![false; 11];
         centre[8] = true;
         let mut feature = centre.clone();
-        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 1);
+        assert_eq!(
+            merge_flat_crossings(&mut mesh, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 11], 1.0),
+            1
+        );
         assert_eq!(mesh.vertex_count(), 10);
         assert_eq!(mesh.triangle_count(), 16);
         assert_eq!(feature.iter().filter(|&&f| f).count(), 1);
@@ -227,7 +238,10 @@ mod tests {
         let mut feature = centre.clone();
         // Ring vertices 1..7 are flat around their own neighbours, but each is joined to the apex
         // below, so none is flat; the raised crossing is off its plane by 0.01 > 1e-3.
-        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 0);
+        assert_eq!(
+            merge_flat_crossings(&mut mesh, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 11], 1.0),
+            0
+        );
         assert_eq!(mesh.triangle_count(), 18);
     }
 
@@ -239,6 +253,9 @@ mod tests {
         centre[8] = true;
         centre[3] = true;
         let mut feature = centre.clone();
-        assert_eq!(merge_flat_crossings(&mut mesh, &mut centre, &mut feature, 1.0), 0);
+        assert_eq!(
+            merge_flat_crossings(&mut mesh, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 11], 1.0),
+            0
+        );
     }
 }

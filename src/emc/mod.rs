@@ -10,6 +10,7 @@
 //! and oriented point clouds ([`point_source::reconstruct`], tangent planes): the paper's §3.1
 //! directed distances for its remeshing (§5.3) and reconstruction (§5.2) applications.
 
+pub mod crease;
 pub mod directed;
 pub mod edges;
 pub mod feature;
@@ -238,10 +239,12 @@ pub fn mesh_with_sampler(
             &mut out.mesh,
             &mut centres.any,
             &mut out.feature_vertex,
+            &mut centres.crease,
             grid.cell_size(),
         );
     }
-    out.feature_edges = lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex);
+    out.feature_edges =
+        lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex, &centres.crease, grid.cell_size());
     timings.flip_ms = ms_since(t2);
     Ok((out, timings))
 }
@@ -333,7 +336,7 @@ fn join_slabs(slabs: Vec<Slab>) -> (EmcMesh, FanCentres, Vec<OutsideFan>) {
                 out.mesh.positions.push(slab.out.mesh.positions[v]);
                 normals.push(slab.normals[v]);
                 out.feature_vertex.push(slab.out.feature_vertex[v]);
-                centres.push(slab.centres.any[v], slab.centres.on_feature[v]);
+                centres.push(slab.centres.any[v], slab.centres.on_feature[v], slab.centres.crease[v]);
             }
         }
         out.mesh.triangles.extend(slab.out.mesh.triangles.iter().map(|t| t.map(|v| global[v as usize])));
@@ -412,14 +415,22 @@ fn extract_slab(
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
                             out.feature_vertex.push(false);
-                            centres.push(false, false);
+                            centres.push(false, false, Vec3::ZERO);
                         }
                         by_edge[e as usize] = *slot;
                     }
                     let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                    // Where the input is a function, a crease is kept only where the surface
+                    // still turns past θ next to it (see `crease`).
+                    if kind != FeatureKind::Smooth
+                        && options.resample_creases
+                        && crease::smooth_at_fine_scale(&pts, &nrm, sampler, options.theta_sharp)
+                    {
+                        kind = FeatureKind::Smooth;
+                    }
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
                         let domain = (grid.origin, grid.max());
@@ -484,7 +495,7 @@ fn extract_slab(
                             out.mesh.positions.push(c);
                             normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                             out.feature_vertex.push(false);
-                            centres.push(false, false);
+                            centres.push(false, false, Vec3::ZERO);
                         }
                         let id = |v: u32| if v == EXTRA { extra_id } else { v };
                         out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
@@ -497,7 +508,11 @@ fn extract_slab(
                     out.mesh.positions.push(f.position);
                     normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
                     out.feature_vertex.push(f.is_feature_vertex());
-                    centres.push(true, f.on_feature);
+                    let crease = match kind {
+                        FeatureKind::Edge => feature::crease_direction(&plan.nrm).unwrap_or(Vec3::ZERO),
+                        _ => Vec3::ZERO,
+                    };
+                    centres.push(true, f.on_feature, crease);
                     match (f.is_feature_vertex(), kind) {
                         (false, _) => out.approximate_features += 1,
                         (true, FeatureKind::Corner) => out.corner_features += 1,
@@ -522,10 +537,14 @@ fn extract_slab(
 struct FanCentres {
     any: Vec<bool>,
     on_feature: Vec<bool>,
+    /// The direction of an edge centre's crease (zero for corners and other vertices): feature
+    /// lines follow it (see [`lines::feature_edges`]).
+    crease: Vec<Vec3>,
 }
 
 impl FanCentres {
-    fn push(&mut self, centre: bool, on_feature: bool) {
+    fn push(&mut self, centre: bool, on_feature: bool, crease: Vec3) {
+        self.crease.push(crease);
         self.any.push(centre);
         self.on_feature.push(on_feature);
     }

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod csg;
+pub mod normals;
 
 use isoforge::mesh::analysis;
 use isoforge::{Grid, Mesh, Vec3};

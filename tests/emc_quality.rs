@@ -1,0 +1,299 @@
+//! EMC against the true surface on every scene from 24 to 128 cells, measured without rendering:
+//! feature lines only where the part has creases, and faces that follow the surface no worse than
+//! MC's polygons on the same crossings. The per-face measure (`common::normals`) takes, per face,
+//! the smallest angle to the true normals at seven points of it, so that a face lying against
+//! either side of a crease reads as right while a tooth, a step, a flip or a chord across a wedge
+//! does not.
+//!
+//! `cargo test --test emc_quality -- --ignored` runs the soak: every scene at every resolution
+//! of the sweep (24, 32, 40, 48, 56, 64, 80, 96, 128), with a table of what it measured.
+
+mod common;
+
+use common::normals::{face_deviations, normal_spread_near};
+use common::{case_seeds, Rng};
+use isoforge::emc::{self, EmcMesh, EmcOptions};
+use isoforge::scenes::{self, SCENE_NAMES};
+use isoforge::{expr, Field, Grid, Vec3};
+
+#[cfg(target_arch = "wasm32")]
+use wasm_bindgen_test::wasm_bindgen_test as test;
+#[cfg(target_arch = "wasm32")]
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
+
+/// The resolutions the measuring tests cover in `cargo test` (the sweep in the soak): the coarse
+/// end and the grids where the scenes' planes and spheres meet grid planes and grid points (40,
+/// 56 and 80 for the cube minus a ball). The feature-line tests of single scenes run the sweep.
+const RES: [usize; 4] = [24, 40, 56, 80];
+/// The soak's sweep.
+const SWEEP: [usize; 9] = [24, 32, 40, 48, 56, 64, 80, 96, 128];
+
+/// A face turned more than this from every true normal near it is a defect (a tooth, a step, a
+/// flip, a chord across a crease): over the largest turn of a smooth surface across one face at
+/// these resolutions (the torus's tube at 24 cells, 3 cells in radius, turns 19° per cell).
+const OFF_DEG: f64 = 30.0;
+
+fn emc_on(field: &dyn Field, grid: &Grid, options: &EmcOptions) -> EmcMesh {
+    emc::mesh_field(field, grid, options).unwrap().0
+}
+
+fn scene_grid(name: &str, res: usize) -> (scenes::Scene, Grid) {
+    let scene = scenes::scene(name).unwrap();
+    let grid = Grid::with_resolution(scene.min, scene.max, res).unwrap();
+    (scene, grid)
+}
+
+/// Fan centres of any kind: none belongs on a smooth surface.
+fn centres(out: &EmcMesh) -> usize {
+    out.edge_features + out.corner_features + out.approximate_features
+}
+
+/// Feature edges whose midpoint has no crease within a quarter cell: the true normals there
+/// agree within 20°, where the scenes' creases open 30° and more (a smooth surface turns 9° in a
+/// quarter cell at the tightest curvature here).
+fn false_feature_edges(out: &EmcMesh, field: &dyn Field, cell: f32) -> Vec<Vec3> {
+    out.feature_edges
+        .iter()
+        .map(|e| (out.mesh.positions[e[0] as usize] + out.mesh.positions[e[1] as usize]) * 0.5)
+        .filter(|&m| normal_spread_near(field, m, cell) < 20.0)
+        .collect()
+}
+
+/// Faces more than [`OFF_DEG`] off the surface, and the largest deviation.
+fn faces_off(out: &EmcMesh, field: &dyn Field, cell: f32) -> (usize, f64) {
+    let devs: Vec<f64> = face_deviations(&out.mesh, field, cell).into_iter().flatten().collect();
+    (devs.iter().filter(|&&d| d > OFF_DEG).count(), devs.iter().copied().fold(0.0, f64::max))
+}
+
+/// MC's polygons on EMC's own crossings (no feature is sharp below a cosine of -1): the baseline
+/// EMC's fans, flips and merges are measured against, free of the difference between
+/// interpolated and exact crossings.
+fn plain_options() -> EmcOptions {
+    EmcOptions { theta_sharp: -1.0, ..EmcOptions::default() }
+}
+
+#[test]
+fn smooth_scenes_have_no_feature_points_at_any_resolution() {
+    for name in ["sphere", "torus"] {
+        for res in SWEEP {
+            let (scene, grid) = scene_grid(name, res);
+            let out = emc_on(scene.field.as_ref(), &grid, &EmcOptions::default());
+            // Measured before the crease check (`emc::crease`): the torus at 24 cells had 192
+            // edge centres and 240 feature edges on its tube.
+            assert_eq!(centres(&out), 0, "{name} at {res}: fan centres on a smooth surface");
+            assert!(
+                out.feature_edges.is_empty(),
+                "{name} at {res}: {} feature edges",
+                out.feature_edges.len()
+            );
+        }
+    }
+}
+
+/// The gyroid sheet is smooth; its only crease is where it meets the clipping ball (radius 0.9).
+#[test]
+fn gyroid_feature_lines_lie_where_the_sheet_meets_its_ball() {
+    for res in SWEEP {
+        let (scene, grid) = scene_grid("gyroid", res);
+        let out = emc_on(scene.field.as_ref(), &grid, &EmcOptions::default());
+        let h = grid.cell_size();
+        let stray: Vec<Vec3> = out
+            .feature_edges
+            .iter()
+            .flat_map(|e| e.map(|v| out.mesh.positions[v as usize]))
+            .filter(|p| (p.length() - 0.9).abs() > h)
+            .collect();
+        assert!(out.feature_edges.len() > 100, "gyroid at {res}: the rim is a crease");
+        assert!(
+            stray.is_empty(),
+            "gyroid at {res}: {} feature vertices off the rim, e.g. {}",
+            stray.len(),
+            stray[0]
+        );
+    }
+}
+
+/// The rocket's nose is a cone from z = 0.35 (on the body) to its apex at 0.8: smooth between.
+#[test]
+fn the_rockets_cone_has_no_feature_lines() {
+    for res in SWEEP {
+        let (scene, grid) = scene_grid("rocket", res);
+        let out = emc_on(scene.field.as_ref(), &grid, &EmcOptions::default());
+        let margin = 1.5 * grid.spacing.z;
+        let on_cone = |v: u32| {
+            let z = out.mesh.positions[v as usize].z;
+            z > 0.35 + margin && z < 0.8 - margin
+        };
+        let across: Vec<&[u32; 2]> =
+            out.feature_edges.iter().filter(|e| on_cone(e[0]) && on_cone(e[1])).collect();
+        assert!(across.is_empty(), "rocket at {res}: {} feature edges on the cone", across.len());
+    }
+}
+
+/// Every scene's feature lines run along its creases. Bridges through approximate centres (see
+/// `emc::lines`) may miss by a little; measured: at most 2.5 % of the edges (the gear at 32
+/// cells, whose teeth are 0.7 cells wide), where the rocket had 13.5 % (63 of 465 at 48 cells,
+/// across its fins' narrow faces) before feature edges had to follow their creases.
+#[test]
+fn feature_lines_lie_on_creases() {
+    check_feature_lines(&RES, &[]);
+}
+
+/// The thin room's walls (0.016 thick, under a cell at every resolution here) are seen from both
+/// sides by one cell: its "creases" there are the paper's opposite-normal edges inside the wall,
+/// which this measure cannot place (at 96 cells every one of its 612 feature edges reads off the
+/// creases). The CI resolutions keep it; the soak leaves it out.
+fn check_feature_lines(resolutions: &[usize], skip: &[&str]) {
+    for name in SCENE_NAMES.into_iter().filter(|n| !skip.contains(n)) {
+        for &res in resolutions {
+            let (scene, grid) = scene_grid(name, res);
+            let out = emc_on(scene.field.as_ref(), &grid, &EmcOptions::default());
+            let stray = false_feature_edges(&out, scene.field.as_ref(), grid.cell_size());
+            let share = stray.len() as f64 / out.feature_edges.len().max(1) as f64;
+            assert!(
+                share <= 0.03,
+                "{name} at {res}: {} of {} feature edges off the creases, e.g. at {}",
+                stray.len(),
+                out.feature_edges.len(),
+                stray[0]
+            );
+        }
+    }
+}
+
+/// On every scene, EMC has no more faces off the surface than MC's polygons on the same grid:
+/// its fans and flips add no teeth or steps beyond what MC's topology already forces (thin
+/// wedges that a grid edge crosses twice, surfaces through grid points). Measured at these
+/// resolutions: EMC 0–780 such faces per scene and resolution where MC has 0–2784 (the cube minus a
+/// ball at 56: 780 against 1952; the rocket at 24: 143 against 179).
+#[test]
+fn emc_puts_no_more_faces_off_the_surface_than_mc() {
+    check_faces(&RES[..3], &[]);
+}
+
+fn check_faces(resolutions: &[usize], skip: &[&str]) {
+    for name in SCENE_NAMES.into_iter().filter(|n| !skip.contains(n)) {
+        for &res in resolutions {
+            let (scene, grid) = scene_grid(name, res);
+            let field = scene.field.as_ref();
+            let h = grid.cell_size();
+            let (off, worst) = faces_off(&emc_on(field, &grid, &EmcOptions::default()), field, h);
+            let (mc_off, mc_worst) = faces_off(&emc_on(field, &grid, &plain_options()), field, h);
+            eprintln!("{name} at {res}: {off} faces off (max {worst:.1}°), MC {mc_off} (max {mc_worst:.1}°)");
+            assert!(off <= mc_off, "{name} at {res}: {off} faces more than {OFF_DEG}° off, MC {mc_off}");
+        }
+    }
+}
+
+/// The soak: every scene at every resolution of the sweep, but the thin room (see
+/// `check_feature_lines`; at 96 cells EMC also has 32 faces off against MC's 16, in its walls).
+#[test]
+#[ignore]
+fn soak_every_scene_at_every_resolution() {
+    check_feature_lines(&SWEEP, &["thin_room"]);
+    check_faces(&SWEEP, &["thin_room"]);
+}
+
+/// Random smooth solids (balls, tori, capsules), some centred on grid points so that the surface
+/// passes through grid points, no thinner than 2.5 cells: no fan centre, no feature line.
+#[test]
+fn random_smooth_solids_have_no_feature_points() {
+    for seed in case_seeds(18_000, 24) {
+        let mut rng = Rng::new(seed);
+        let res = 24 + rng.below(41) as usize;
+        let h = 2.0 / res as f32;
+        let coord = |rng: &mut Rng| {
+            let c = rng.range(-0.2, 0.2);
+            if rng.below(2) == 0 {
+                (c / h).round() * h
+            } else {
+                c
+            }
+        };
+        let (x, y, z) = (coord(&mut rng), coord(&mut rng), coord(&mut rng));
+        let thick = 2.5 * h;
+        let text = match rng.below(3) {
+            0 => format!("translate(sphere({}), {x}, {y}, {z})", rng.range(thick, 0.7)),
+            1 => {
+                let minor = rng.range(thick, 0.3);
+                format!(
+                    "translate(torus({}, {minor}), {x}, {y}, {z})",
+                    rng.range(minor + thick, 0.75 - minor)
+                )
+            }
+            _ => format!("capsule({x}, {y}, {z}, {}, {}, {}, {})", -x, 0.3, z * 0.5, rng.range(thick, 0.4)),
+        };
+        let field = expr::compile(&text).unwrap();
+        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res).unwrap();
+        let out = emc_on(&field, &grid, &EmcOptions::default());
+        assert!(out.mesh.triangle_count() > 0, "seed {seed}: {text} at {res}");
+        assert_eq!(centres(&out), 0, "seed {seed}: {text} at {res}: fan centres on a smooth surface");
+    }
+}
+
+/// Random boxes and unions of two boxes whose faces lie on grid planes (their samples there are
+/// 0 and count as outside), so that every crease lies in a grid line: every feature line lies on
+/// a crease; a box is exact (no face off), a union no worse than MC's polygons. Unions are not
+/// exact yet: 19 of 61 seeds have 1–10 faces off, small ones (0.01–0.3 cells²) around
+/// approximate centres where concave creases meet in a grid line, one of them flipped (see the
+/// ignored regressions below).
+#[test]
+fn random_boxes_on_grid_planes() {
+    for seed in case_seeds(18_100, 16) {
+        let mut rng = Rng::new(seed);
+        let res = 24 + 2 * rng.below(21) as usize;
+        let h = 2.0 / res as f32;
+        let cells = |rng: &mut Rng, lo: u64, n: u64| (lo + rng.below(n)) as f32 * h;
+        let part = |rng: &mut Rng| {
+            let (hx, hy, hz) = (cells(rng, 2, 8), cells(rng, 2, 8), cells(rng, 2, 8));
+            let (x, y, z) = (cells(rng, 0, 5), cells(rng, 0, 5), cells(rng, 0, 5));
+            format!("translate(box({hx}, {hy}, {hz}), {x}, {y}, {z})")
+        };
+        let a = part(&mut rng);
+        let union = rng.below(2) == 1;
+        let text = if union { format!("union({a}, {})", part(&mut rng)) } else { a };
+        let field = expr::compile(&text).unwrap();
+        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res).unwrap();
+        let out = emc_on(&field, &grid, &EmcOptions::default());
+        let (off, worst) = faces_off(&out, &field, grid.cell_size());
+        let allowed = if union {
+            faces_off(&emc_on(&field, &grid, &plain_options()), &field, grid.cell_size()).0
+        } else {
+            0
+        };
+        assert!(off <= allowed, "seed {seed}: {text} at {res}: {off} faces off, worst {worst:.1}°");
+        let stray = false_feature_edges(&out, &field, grid.cell_size());
+        assert!(stray.is_empty(), "seed {seed}: {text} at {res}: feature edges off the creases at {stray:?}");
+    }
+}
+
+/// Shrunk from `random_boxes_on_grid_planes` (seed 18120): two boxes on grid planes at 30 cells,
+/// a concave corner where their creases meet in a grid line. An approximate centre 0.06 cells
+/// outside its cell leaves one face of 0.014 cells² flipped (166° off). Open: ignored until fixed.
+#[test]
+#[ignore]
+fn union_of_boxes_on_grid_planes_has_no_flipped_face() {
+    regression(
+        "union(translate(box(1/3, 4/15, 2/5), 0, 1/5, 1/5), translate(box(2/5, 1/3, 1/3), 2/15, 4/15, 2/15))",
+        30,
+    );
+}
+
+/// Shrunk from `random_boxes_on_grid_planes` (seed 18109): at 48 cells, 10 faces up to 83° off
+/// around approximate centres where the two boxes' concave creases run in grid lines. Open.
+#[test]
+#[ignore]
+fn union_of_boxes_on_grid_planes_has_no_teeth() {
+    regression(
+        "union(translate(box(1/8, 7/24, 5/24), 1/24, 0, 1/8), translate(box(1/4, 1/4, 1/6), 0, 0, 1/8))",
+        48,
+    );
+}
+
+fn regression(text: &str, res: usize) {
+    let field = expr::compile(text).unwrap();
+    let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res).unwrap();
+    let out = emc_on(&field, &grid, &EmcOptions::default());
+    let (off, worst) = faces_off(&out, &field, grid.cell_size());
+    assert_eq!(off, 0, "{text} at {res}: {off} faces off, worst {worst:.1}°");
+}
