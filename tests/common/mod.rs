@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod csg;
+pub mod hausdorff;
 pub mod normals;
 
 use isoforge::mesh::analysis;
