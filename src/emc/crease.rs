@@ -22,6 +22,11 @@ const HALVINGS: usize = 5;
 /// Disagreeing pairs of crossings walked, the most different first; a crease between two groups
 /// of crossings separates the widest pairs, so these find it where any would.
 const PAIRS: usize = 4;
+/// After this many halvings, a path whose jump has not shrunk below [`KEPT`] of the first one is
+/// a crease: a smooth bend's would be a quarter of it by now. Real creases, most of the sharp
+/// cells of a CAD part, are then settled with two root findings rather than five.
+const SETTLED_AFTER: usize = 2;
+const KEPT: f32 = 0.8;
 /// Pairs whose normals are nearly opposite (a thin sheet seen from both sides) have no direction
 /// to walk the surface in: their mean normal is shorter than this, and the crease is kept.
 const MIN_MEAN: f32 = 0.2;
@@ -74,7 +79,11 @@ pub fn path_is_smooth(
         sampler.crossing_on_segment(q - mean * reach, q + mean * reach).map(|(_, n)| n)
     };
     let (mut s0, mut n0, mut s1, mut n1) = (0.0f32, a.1, 1.0f32, b.1);
-    for _ in 0..HALVINGS {
+    let first_jump = n0.angle_between(n1);
+    for halving in 0..HALVINGS {
+        if halving == SETTLED_AFTER && n0.angle_between(n1) >= KEPT * first_jump {
+            return Some(false);
+        }
         let s = 0.5 * (s0 + s1);
         let n = normal_at(s)?;
         if n == Vec3::ZERO {
