@@ -76,8 +76,14 @@ test('cross-origin isolated: a running call stops at a checkpoint and the worker
   const out = await inMesherPage(isolated, async (createMesher, balls) => {
     const mesher = createMesher();
     const progress = [];
-    const long = mesher.meshExpr(balls, { method: 'emc', res: 256 }, { onProgress: (p) => progress.push(p) });
-    await new Promise((r) => setTimeout(r, 1500));
+    let started;
+    const running = new Promise((r) => { started = r; });
+    const long = mesher.meshExpr(balls, { method: 'emc', res: 256 }, {
+      onProgress: (p) => { progress.push(p); started(); },
+    });
+    // Cancel once the call runs (loading the module and starting its threads comes first).
+    await running;
+    await new Promise((r) => setTimeout(r, 500));
     const t = performance.now();
     mesher.cancel();
     const error = await long.then(() => 'resolved', (e) => e.name);
