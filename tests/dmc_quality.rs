@@ -115,7 +115,7 @@ fn dmc_needs_far_fewer_triangles_than_mc_for_the_same_max_error() {
 /// Every scene at depth 6 (the CLI's `--res 64`), default options: under 2 % of the triangles
 /// have an angle under 10°, and no face turns from the surface by more than [`MAX_DEV_DEG`]
 /// (per face, against the nearest of the true normals at its corners and inner points, see
-/// `dmc::quality`): no spikes, nothing turned over; what is left is a face cutting a 90° crease
+/// `common::quality`, the measure EMC is held to): no spikes, nothing turned over; what is left is a face cutting a 90° crease
 /// at a corner of the octree (measured: at most 45.7°, the rocket).
 ///
 /// The thin room is held to [`THIN_ROOM_SLIVERS`] instead: its walls are thinner than a finest
@@ -131,7 +131,7 @@ fn every_scene_has_few_slivers_and_no_spikes() {
         let h = (scene.max - scene.min).max_element() / 64.0;
         let clipped =
             dmc::bounds::Clipped { field: scene.field.as_ref(), iso: 0.0, min: scene.min, max: scene.max };
-        let q = dmc::quality::measure(&mesh, &clipped, 0.0, h);
+        let q = common::quality::measure(&mesh, &clipped, h);
         eprintln!(
             "{name}: {} triangles, {:.2} % under 10°, min angle {:.2}°, normal deviation max {:.1}°, {} faces over 20°",
             mesh.triangle_count(),

@@ -340,7 +340,7 @@ fn prop_dmc_simplification_keeps_the_finest_levels_topology() {
 
 /// DMC's triangles on random trees: under [`TREE_SLIVERS`] of them with an angle under 10°, and
 /// no face turned over (per face, against the nearest true normal of the clipped shape at its
-/// corners and inner points, `dmc::quality`). Looser than on the scenes (2 %, 50°), measured on a
+/// corners and inner points, `common::quality`, the measure EMC is held to). Looser than on the scenes (2 %, 50°), measured on a
 /// soak of 60 trees: a tree meshed at 16 to 32 cells has a few hundred triangles, where a handful
 /// of slivers is a few percent (at most 4.6 %, 656 triangles); and a part thinner than a finest
 /// cell has faces across its rim from one sheet to the other, which turn by up to 90° (88.7°).
@@ -361,7 +361,7 @@ fn check_dmc_quality(case: &Case) {
     let h = (max - min).max_element() / (1u32 << max_depth) as f32;
     // The shape as DMC meshes it: closed by the bounds' faces where it reaches past them.
     let clipped = dmc::bounds::Clipped { field: &case.program, iso: 0.0, min, max };
-    let q = dmc::quality::measure(&mesh, &clipped, 0.0, h);
+    let q = common::quality::measure(&mesh, &clipped, h);
     eprintln!(
         "seed {}: {} triangles, {:.2} % under 10°, deviation max {:.1}°",
         case.seed,

@@ -39,7 +39,6 @@ pub mod contour;
 pub mod dual;
 pub mod fidelity;
 pub mod qef;
-pub mod quality;
 pub mod safety;
 pub mod simplify;
 pub mod slivers;

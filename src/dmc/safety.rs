@@ -30,25 +30,47 @@ pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
 /// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
 pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriangle>> {
     let (lo, hi) = tree.int_box(n);
-    let mut shared = Vec::new();
-    neighbour_corners(tree, 0, n, lo, hi, &mut shared);
-    let mut before = shared.clone();
+    // The star's points before the merge: the children's corners and the neighbours' corners on
+    // the node's closed box. After it, the children's corners that are neither the node's own nor
+    // a neighbour's are no octree vertices any more; the others keep their dual cells, with every
+    // child among their leaves replaced by the node. So each point's leaves are located once.
+    let mut points = Vec::new();
+    neighbour_corners(tree, 0, n, lo, hi, &mut points);
+    let kept = unique(points.clone());
     let first = tree.nodes[n as usize].children;
     for c in 0..8 {
         let child = first + c;
         if tree.nodes[child as usize].kind != Kind::Absent {
-            push_corners(tree, child, &mut before);
+            push_corners(tree, child, &mut points);
         }
     }
-    let mut after = shared;
-    push_corners(tree, n, &mut after);
-    let (before, after) = (unique(before), unique(after));
+    let points = unique(points);
+    let is_kept = |p: [u32; 3]| {
+        kept.binary_search_by_key(&dual::point_key(p), |&q| dual::point_key(q)).is_ok()
+            || (0..3).all(|a| p[a] == lo[a] || p[a] == hi[a])
+    };
+    let children = first..first + 8;
+    let mut cells_before = Vec::with_capacity(points.len());
+    let mut cells_after = Vec::with_capacity(points.len());
+    for &p in &points {
+        let Some(cell) = dual_cell(tree, p, NONE) else { continue };
+        cells_before.push(cell);
+        if is_kept(p) {
+            cells_after.push(cell.map(|k| {
+                if children.contains(&k.node) {
+                    VertexKey { node: n, ..k }
+                } else {
+                    k
+                }
+            }));
+        }
+    }
     let sign_before = |k: VertexKey| dual::inside(tree, k);
     let sign_after =
         |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
     let mut crossings = Crossings::default();
-    let tris_before = star_triangles(tree, &before, NONE, &sign_before, &mut crossings);
-    let tris_after = star_triangles(tree, &after, n, &sign_after, &mut crossings);
+    let tris_before = star_triangles(&cells_before, &sign_before, &mut crossings);
+    let tris_after = star_triangles(&cells_after, &sign_after, &mut crossings);
     let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
         let mut by_id =
             vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
@@ -129,19 +151,16 @@ impl Crossings {
     }
 }
 
-/// The contour's triangles in the dual cells at `points` (with `merged` as a leaf), as crossing ids;
-/// triangles that collapse in a degenerate cell are dropped, as [`super::contour`] drops them.
+/// The contour's triangles in the dual cells `cells`, as crossing ids; triangles that collapse in a
+/// degenerate cell are dropped, as [`super::contour`] drops them.
 fn star_triangles(
-    tree: &Octree,
-    points: &[[u32; 3]],
-    merged: u32,
+    cells: &[[VertexKey; 8]],
     inside: &dyn Fn(VertexKey) -> bool,
     crossings: &mut Crossings,
 ) -> Vec<[u32; 3]> {
     let table = triangle_table();
     let mut out = Vec::new();
-    for &p in points {
-        let Some(cell) = dual_cell(tree, p, merged) else { continue };
+    for cell in cells {
         let signs = cell.map(inside);
         let case = signs.iter().enumerate().fold(0u8, |c, (i, &s)| c | (s as u8) << i);
         if case == 0 || case == 255 {

@@ -55,6 +55,43 @@ fn merge(tree: &mut Octree, n: u32, qef: Option<Qef>, vertex: Vec3, value: f32) 
     }
 }
 
+/// A proposed merge: the node, its children's summed QEF (none if no child has one), the vertex
+/// it would have and whether that vertex is free inside its box.
+struct Proposal {
+    node: u32,
+    qef: Option<Qef>,
+    vertex: Vec3,
+    free: bool,
+}
+
+/// What the QEF says of making node `n` a leaf: `None` while a child is still internal, `Err`
+/// where the summed QEF does not fit one vertex within the tolerance (a NaN residual, from a
+/// degenerate QEF, refuses it too).
+fn propose(tree: &Octree, n: u32, tolerance: f32) -> Option<Result<Proposal, ()>> {
+    let first = tree.nodes[n as usize].children;
+    let children = (first..first + 8).map(|c| tree.nodes[c as usize]);
+    if children.clone().any(|c| c.kind == Kind::Internal) {
+        return None;
+    }
+    let (lo, hi) = tree.world_box(n);
+    let mut qef: Option<Qef> = None;
+    for c in children.filter(|c| c.kind == Kind::Surface && c.qef != super::tree::NONE) {
+        let q = &tree.qefs[c.qef as usize];
+        match &mut qef {
+            Some(sum) => sum.merge(q),
+            None => qef = Some(*q),
+        }
+    }
+    let Some(q) = &qef else {
+        return Some(Ok(Proposal { node: n, qef, vertex: (lo + hi) * 0.5, free: true }));
+    };
+    let placed = place(q, lo, hi);
+    if placed.rms.is_nan() || placed.rms > tolerance as f64 {
+        return Some(Err(()));
+    }
+    Some(Ok(Proposal { node: n, qef, vertex: placed.vertex, free: placed.free }))
+}
+
 /// Merges bottom-up; `tolerance` (world units) bounds both the root-mean-square 4-D distance of a
 /// leaf's sampled tangent planes from its vertex and the distance of the triangles a merge makes
 /// from the surface ([`super::fidelity`]).
@@ -76,49 +113,29 @@ pub fn simplify(
         // Reported as the second half of the "octree" phase (the stats count simplification there).
         let done = (tree.depth as usize - 1 - level) as f32 / tree.depth.max(1) as f32;
         crate::progress::checkpoint("octree", 0.5 + 0.5 * done)?;
-        // Candidates whose children are all leaves, with the vertex the merged leaf would have.
-        let mut candidates: Vec<(u32, Option<Qef>, Vec3, bool)> = Vec::new();
-        for &n in &by_level[level] {
-            let first = tree.nodes[n as usize].children;
-            let children = (first..first + 8).map(|c| tree.nodes[c as usize]);
-            if children.clone().any(|c| c.kind == Kind::Internal) {
-                continue;
+        // Candidates whose children are all leaves, with the vertex the merged leaf would have;
+        // each placed on its own (in parallel where there are threads), in the level's order.
+        let proposed =
+            crate::par::map(by_level[level].len(), |i| propose(tree, by_level[level][i], tolerance));
+        let mut candidates: Vec<Proposal> = Vec::new();
+        for p in proposed.into_iter().flatten() {
+            match p {
+                Ok(p) => candidates.push(p),
+                Err(()) => stats.qef_refused += 1,
             }
-            let (lo, hi) = tree.world_box(n);
-            let mut qef: Option<Qef> = None;
-            let mut vertex = (lo + hi) * 0.5;
-            let mut free = true;
-            for c in children.filter(|c| c.kind == Kind::Surface && c.qef != super::tree::NONE) {
-                let q = &tree.qefs[c.qef as usize];
-                match &mut qef {
-                    Some(sum) => sum.merge(q),
-                    None => qef = Some(*q),
-                }
-            }
-            if let Some(q) = &qef {
-                let placed = place(q, lo, hi);
-                // A NaN residual (a degenerate QEF) refuses the merge too.
-                if placed.rms.is_nan() || placed.rms > tolerance as f64 {
-                    stats.qef_refused += 1;
-                    continue;
-                }
-                vertex = placed.vertex;
-                free = placed.free;
-            }
-            candidates.push((n, qef, vertex, free));
         }
         if candidates.is_empty() {
             continue;
         }
-        let mut points: Vec<Vec3> = candidates.iter().map(|c| c.2).collect();
+        let mut points: Vec<Vec3> = candidates.iter().map(|c| c.vertex).collect();
         let centres: Vec<Vec3> = candidates
             .iter()
             .map(|c| {
-                let (lo, hi) = tree.world_box(c.0);
+                let (lo, hi) = tree.world_box(c.node);
                 (lo + hi) * 0.5
             })
             .collect();
-        let free: Vec<bool> = candidates.iter().map(|c| c.3).collect();
+        let free: Vec<bool> = candidates.iter().map(|c| c.free).collect();
         let values = super::build::settle_vertices(field, iso, &mut points, &centres, &free, tree.h);
         // The candidates in eight classes by the parity of their position: two of one class are a
         // node apart, so no dual cell has leaves of both and their tests do not depend on each
@@ -130,17 +147,26 @@ pub fn simplify(
         };
         let mut classes: [Vec<usize>; 8] = Default::default();
         for (i, c) in candidates.iter().enumerate() {
-            classes[class(c.0)].push(i);
+            classes[class(c.node)].push(i);
         }
         for members in &classes {
+            // The candidate vertices, read by the tests through the (still internal) nodes.
+            for &i in members {
+                let n = candidates[i].node as usize;
+                tree.nodes[n].vertex = points[i];
+                tree.nodes[n].value = values[i];
+            }
+            let tested = {
+                let tree = &*tree;
+                crate::par::map(members.len(), |k| {
+                    let i = members[k];
+                    merge_is_safe(tree, candidates[i].node, values[i])
+                })
+            };
             let mut safe = Vec::new();
             let mut stars = Vec::new();
-            for &i in members {
-                let n = candidates[i].0;
-                // The candidate vertex, read by the tests through the (still internal) node.
-                tree.nodes[n as usize].vertex = points[i];
-                tree.nodes[n as usize].value = values[i];
-                match merge_is_safe(tree, n, values[i]) {
+            for (&i, star) in members.iter().zip(tested) {
+                match star {
                     Some(star) => {
                         safe.push(i);
                         stars.push(star);
@@ -155,7 +181,7 @@ pub fn simplify(
                     continue;
                 }
                 stats.merged += 1;
-                merge(tree, candidates[i].0, candidates[i].1.take(), points[i], values[i]);
+                merge(tree, candidates[i].node, candidates[i].qef.take(), points[i], values[i]);
             }
         }
     }

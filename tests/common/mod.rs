@@ -5,6 +5,7 @@
 pub mod csg;
 pub mod hausdorff;
 pub mod normals;
+pub mod quality;
 
 use isoforge::mesh::analysis;
 use isoforge::{Grid, Mesh, Vec3};
