@@ -179,10 +179,7 @@ struct Work<'a> {
     alive: Vec<bool>,
     faces_of: Vec<Vec<u32>>,
     fixed: Vec<bool>,
-    grid: rustc_hash::FxHashMap<[i32; 3], Vec<u32>>,
-    cell: f64,
-    seen: Vec<u32>,
-    stamp: u32,
+    nearby: crate::mesh::buckets::TriangleBuckets,
 }
 
 impl Work<'_> {
@@ -204,41 +201,14 @@ impl Work<'_> {
         Shape { angle, deviation, bad: angle < SLIVER_DEG || deviation > SPIKE_DEG || short }
     }
 
-    fn keys(&self, c: &Corners) -> ([i32; 3], [i32; 3]) {
-        let lo = c[0].min(c[1]).min(c[2]);
-        let hi = c[0].max(c[1]).max(c[2]);
-        let k = |p: glam::DVec3| (p / self.cell).floor().as_ivec3().to_array();
-        (k(lo), k(hi))
+    fn bounds(&self, f: u32) -> (glam::DVec3, glam::DVec3) {
+        crate::mesh::buckets::bounds(&self.corners(self.triangles[f as usize]))
     }
 
-    fn insert(&mut self, f: u32) {
-        let (lo, hi) = self.keys(&self.corners(self.triangles[f as usize]));
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    self.grid.entry([x, y, z]).or_default().push(f);
-                }
-            }
-        }
-    }
-
-    /// Live triangles whose boxes' cells meet `c`'s.
+    /// Live triangles whose boxes meet `c`'s.
     fn near(&mut self, c: &Corners, out: &mut Vec<u32>) {
-        self.stamp += 1;
-        let (lo, hi) = self.keys(c);
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    let Some(list) = self.grid.get(&[x, y, z]) else { continue };
-                    for &f in list {
-                        if self.alive[f as usize] && self.seen[f as usize] != self.stamp {
-                            self.seen[f as usize] = self.stamp;
-                            out.push(f);
-                        }
-                    }
-                }
-            }
-        }
+        let (lo, hi) = crate::mesh::buckets::bounds(c);
+        self.nearby.query(lo, hi, out);
     }
 
     /// Whether `change` is an improvement that keeps the surface where it was, and how good: it
@@ -427,13 +397,17 @@ impl Work<'_> {
                 self.faces_of[v as usize].retain(|&g| g != f);
             }
             match t {
-                None => self.alive[f as usize] = false,
+                None => {
+                    self.alive[f as usize] = false;
+                    self.nearby.remove(f);
+                }
                 Some(t) => {
                     self.triangles[f as usize] = t;
                     for v in t {
                         self.faces_of[v as usize].push(f);
                     }
-                    self.insert(f);
+                    let (lo, hi) = self.bounds(f);
+                    self.nearby.insert(f, lo, hi);
                 }
             }
         }
@@ -466,7 +440,7 @@ impl Work<'_> {
 /// larger worst angle), lie along the surface (within [`MAX_TURN_DEG`] of the true normal at a
 /// corner, or no worse than the worst triangle they replace), stay within the tolerance of the
 /// surface (or no farther than the old ones), and neither cross nor fold onto any triangle nearby
-/// (the analysis's exact tests, on the triangles in a hash grid of finest cells).
+/// (the analysis's exact tests, on the triangles in [`crate::mesh::buckets`] of finest cells).
 ///
 /// **Why it is bounded.** At most [`PASSES`] passes over the bad triangles, each change removing
 /// a vertex or replacing two triangles by better ones; the caller reports what it did.
@@ -510,14 +484,13 @@ pub fn improve(
         alive: vec![true; mesh.triangles.len()],
         faces_of,
         fixed,
-        grid: Default::default(),
-        cell: h as f64,
-        seen: vec![0; mesh.triangles.len()],
-        stamp: 0,
+        nearby: crate::mesh::buckets::TriangleBuckets::build(
+            h as f64,
+            mesh.triangles
+                .iter()
+                .map(|t| crate::mesh::buckets::bounds(&t.map(|v| mesh.positions[v as usize].as_dvec3()))),
+        ),
     };
-    for f in 0..work.triangles.len() as u32 {
-        work.insert(f);
-    }
     let mut out = Improved::default();
     for pass in 0..PASSES {
         let bad = work.bad_faces();

@@ -8,11 +8,11 @@
 //! neither new triangle crosses any triangle near it as the mesh stands (see
 //! [`super::nearby`]); each accepted flip then leaves every pair it did not touch as it was.
 
-use super::nearby::TriangleBuckets;
+use super::nearby::NearbyTriangles;
 use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
 use glam::Vec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// One pass over all edges; returns how many were flipped. `is_feature` marks the fan centres,
 /// `on_feature` those of them that lie on their feature: a flip must join two centres, at least
@@ -34,7 +34,7 @@ pub fn flip_toward_features(
     // once in each direction.
     // Only triangles at a feature point can take part in a flip (both triangles of a flipped edge
     // have one), which keeps this map small: feature cells are few.
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::default();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         if !tri.iter().any(|&v| is_feature[v as usize]) {
             continue;
@@ -45,7 +45,8 @@ pub fn flip_toward_features(
     }
     let mut candidates: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
     candidates.sort_unstable();
-    let mut buckets = TriangleBuckets::new(mesh, spacing);
+    // Built on the first flip that gets as far as the crossing test.
+    let mut nearby: Option<NearbyTriangles> = None;
     let mut flips = 0;
     for (a, b) in candidates {
         let (Some(&t1), Some(&t2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
@@ -99,11 +100,9 @@ pub fn flip_toward_features(
             continue;
         }
         let (tri1, tri2) = ([c, a, d], [d, b, c]);
+        let buckets = nearby.get_or_insert_with(|| NearbyTriangles::new(mesh, spacing));
         if [tri1, tri2].iter().any(|&t| buckets.crosses(mesh, t, &t.map(p), &[t1, t2])) {
             continue;
-        }
-        for t in [t1, t2] {
-            buckets.remove(t, &mesh.corners(t as usize));
         }
         mesh.triangles[t1 as usize] = tri1;
         mesh.triangles[t2 as usize] = tri2;

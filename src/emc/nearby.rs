@@ -5,82 +5,58 @@
 //! triangles that span two cells or leave their own, so the cell a triangle was emitted for no
 //! longer says where it is. Each of those passes asks, before it changes the mesh, whether the
 //! triangles it would make cross any triangle nearby; this answers "nearby" from where the
-//! triangles actually are, so the question covers every triangle that can be hit.
+//! triangles actually are ([`crate::mesh::buckets`]), so the question covers every triangle that
+//! can be hit. The callers build it on their first question: on smooth surfaces there is none.
 
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
+use crate::mesh::buckets::{bounds, TriangleBuckets};
 use crate::mesh::Mesh;
-use glam::{DVec3, IVec3, Vec3};
-use std::collections::HashMap;
+use glam::{DVec3, Vec3};
 
-/// Triangles by the buckets (cells of size `spacing`) their bounding boxes overlap.
-pub struct TriangleBuckets {
-    spacing: Vec3,
-    buckets: HashMap<IVec3, Vec<u32>>,
+/// A mesh's triangles by where they are, for crossing tests.
+pub struct NearbyTriangles {
+    buckets: TriangleBuckets,
 }
 
-impl TriangleBuckets {
-    /// Buckets of size `spacing` (a grid's cell) over every triangle of `mesh`.
-    pub fn new(mesh: &Mesh, spacing: Vec3) -> TriangleBuckets {
-        let mut out = TriangleBuckets { spacing, buckets: HashMap::new() };
-        for t in 0..mesh.triangles.len() {
-            out.insert(t as u32, &mesh.corners(t));
-        }
-        out
+fn corners64(corners: &[Vec3; 3]) -> [DVec3; 3] {
+    corners.map(|p| p.as_dvec3())
+}
+
+impl NearbyTriangles {
+    /// Every triangle of `mesh`, in buckets of a grid cell (`spacing`'s longest side).
+    pub fn new(mesh: &Mesh, spacing: Vec3) -> NearbyTriangles {
+        let boxes = (0..mesh.triangles.len()).map(|t| bounds(&corners64(&mesh.corners(t))));
+        NearbyTriangles { buckets: TriangleBuckets::build(spacing.max_element() as f64, boxes) }
     }
 
-    /// The bucket keys a box overlaps (grown by a thousandth of a bucket, so that a triangle
-    /// touching a bucket's side is found from both).
-    fn keys(&self, lo: Vec3, hi: Vec3) -> impl Iterator<Item = IVec3> {
-        let margin = self.spacing * 1e-3;
-        let a = ((lo - margin) / self.spacing).floor().as_ivec3();
-        let b = ((hi + margin) / self.spacing).floor().as_ivec3();
-        (a.z..=b.z)
-            .flat_map(move |z| (a.y..=b.y).flat_map(move |y| (a.x..=b.x).map(move |x| IVec3::new(x, y, z))))
-    }
-
-    fn bounds(corners: &[Vec3; 3]) -> (Vec3, Vec3) {
-        (corners[0].min(corners[1]).min(corners[2]), corners[0].max(corners[1]).max(corners[2]))
-    }
-
-    /// Records triangle `t` with these corners.
+    /// Records triangle `t` with these corners (in place of those it had).
     pub fn insert(&mut self, t: u32, corners: &[Vec3; 3]) {
-        let (lo, hi) = Self::bounds(corners);
-        let keys: Vec<IVec3> = self.keys(lo, hi).collect();
-        for key in keys {
-            self.buckets.entry(key).or_default().push(t);
-        }
+        let (lo, hi) = bounds(&corners64(corners));
+        self.buckets.insert(t, lo, hi);
     }
 
-    /// Forgets triangle `t`, recorded with these corners.
-    pub fn remove(&mut self, t: u32, corners: &[Vec3; 3]) {
-        let (lo, hi) = Self::bounds(corners);
-        let keys: Vec<IVec3> = self.keys(lo, hi).collect();
-        for key in keys {
-            if let Some(list) = self.buckets.get_mut(&key) {
-                list.retain(|&u| u != t);
-            }
-        }
+    /// Forgets triangle `t`.
+    pub fn remove(&mut self, t: u32) {
+        self.buckets.remove(t);
     }
 
-    /// Every recorded triangle whose buckets overlap the box of `corners` (each once, ascending).
-    pub fn near(&self, corners: &[Vec3; 3]) -> Vec<u32> {
-        let (lo, hi) = Self::bounds(corners);
-        let mut out: Vec<u32> =
-            self.keys(lo, hi).filter_map(|k| self.buckets.get(&k)).flatten().copied().collect();
+    /// Every recorded triangle whose buckets overlap the box of `corners`, each once, ascending.
+    pub fn near(&mut self, corners: &[Vec3; 3]) -> Vec<u32> {
+        let (lo, hi) = bounds(&corners64(corners));
+        let mut out = Vec::new();
+        self.buckets.query(lo, hi, &mut out);
         out.sort_unstable();
-        out.dedup();
         out
     }
 
     /// Whether the triangle `ids` at `corners` crosses any recorded triangle of `mesh` nearby other
     /// than those in `skip`, by the self-intersection checker's rules (sharing an edge never
     /// counts, sharing a vertex counts when they overlap beyond it).
-    pub fn crosses(&self, mesh: &Mesh, ids: [u32; 3], corners: &[Vec3; 3], skip: &[u32]) -> bool {
-        let at = |c: &[Vec3; 3]| c.map(|p| p.as_dvec3());
-        let new: ([u32; 3], [DVec3; 3]) = (ids, at(corners));
+    pub fn crosses(&mut self, mesh: &Mesh, ids: [u32; 3], corners: &[Vec3; 3], skip: &[u32]) -> bool {
+        let new: ([u32; 3], [DVec3; 3]) = (ids, corners64(corners));
         self.near(corners).into_iter().filter(|t| !skip.contains(t)).any(|t| {
             let t = t as usize;
-            indexed_pair_intersects(new, (mesh.triangles[t], at(&mesh.corners(t))))
+            indexed_pair_intersects(new, (mesh.triangles[t], corners64(&mesh.corners(t))))
         })
     }
 }
@@ -107,12 +83,12 @@ mod tests {
     #[test]
     fn finds_the_triangles_near_a_box_and_forgets_removed_ones() {
         let m = mesh();
-        let mut buckets = TriangleBuckets::new(&m, Vec3::ONE);
+        let mut buckets = NearbyTriangles::new(&m, Vec3::ONE);
         let probe = [Vec3::new(0.2, 0.2, -0.5), Vec3::new(0.3, 0.2, 0.5), Vec3::new(0.2, 0.3, 0.5)];
         assert_eq!(buckets.near(&probe), vec![0]);
         assert!(buckets.crosses(&m, [10, 11, 12], &probe, &[]), "the probe pierces triangle 0");
         assert!(!buckets.crosses(&m, [10, 11, 12], &probe, &[0]), "unless it is skipped");
-        buckets.remove(0, &m.corners(0));
+        buckets.remove(0);
         assert!(buckets.near(&probe).is_empty());
         let far = [Vec3::new(5.2, 5.2, 4.5), Vec3::new(5.3, 5.2, 5.5), Vec3::new(5.2, 5.3, 5.5)];
         assert_eq!(buckets.near(&far), vec![1]);

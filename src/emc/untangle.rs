@@ -12,11 +12,11 @@
 //! change, never the connectivity, so the mesh stays MC's topology.
 
 use super::feature::FeatureKind;
-use super::nearby::TriangleBuckets;
+use super::nearby::NearbyTriangles;
 use super::placement::Placement;
 use crate::mesh::Mesh;
 use glam::Vec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// A fan whose centre lies outside its cell, and where it would go inside.
 #[derive(Debug, Clone, Copy)]
@@ -36,6 +36,9 @@ pub fn pull_back_crossing_fans(
     spacing: Vec3,
     fans: &mut Vec<OutsideFan>,
 ) -> Vec<OutsideFan> {
+    if fans.is_empty() {
+        return Vec::new();
+    }
     let mut incident: HashMap<u32, Vec<u32>> = fans.iter().map(|f| (f.vertex, Vec::new())).collect();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for v in tri {
@@ -44,7 +47,7 @@ pub fn pull_back_crossing_fans(
             }
         }
     }
-    let mut buckets = TriangleBuckets::new(mesh, spacing);
+    let mut buckets = NearbyTriangles::new(mesh, spacing);
     let mut moved = Vec::new();
     fans.retain(|fan| {
         let own = &incident[&fan.vertex];
@@ -53,9 +56,6 @@ pub fn pull_back_crossing_fans(
             buckets.crosses(mesh, mesh.triangles[s_], &mesh.corners(s_), &[s])
         });
         if cuts {
-            for &s in own {
-                buckets.remove(s, &mesh.corners(s as usize));
-            }
             mesh.positions[fan.vertex as usize] = fan.inside.position;
             for &s in own {
                 buckets.insert(s, &mesh.corners(s as usize));

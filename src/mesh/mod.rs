@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 pub mod analysis;
+pub mod buckets;
 pub mod decimate;
 pub mod export;
 pub mod pleats;

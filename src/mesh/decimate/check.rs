@@ -92,10 +92,6 @@ impl State<'_> {
                     continue;
                 }
                 let c = self.corners(g);
-                let (glo, ghi) = bounds(&c);
-                if glo.cmpgt(hi).any() || ghi.cmplt(lo).any() {
-                    continue;
-                }
                 if indexed_pair_intersects((t, corners[i]), (self.tris[g as usize], c)) {
                     return true;
                 }

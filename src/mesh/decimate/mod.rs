@@ -18,23 +18,22 @@
 //! edge orientations (the mesh stays a closed oriented 2-manifold of the same Euler
 //! characteristic), no face turned by more than [`DecimateOptions::max_normal_turn_deg`], no
 //! degenerate faces, no new angle below [`DecimateOptions::min_angle_deg`] unless the faces it
-//! replaces were already worse, no crossing with any face nearby (a hash grid of the faces and
+//! replaces were already worse, no crossing with any face nearby ([`crate::mesh::buckets`] of the faces and
 //! the analysis's exact triangle-pair test), and with a field, no new vertex or face sample
 //! farther than [`DecimateOptions::max_error`] from the zero set.
 
 mod check;
 mod flip;
 mod quadric;
-mod spatial;
 
 use crate::error::Error;
 use crate::field::Field;
+use crate::mesh::buckets::{bounds, TriangleBuckets};
 use crate::mesh::Mesh;
 use crate::progress::checkpoint;
 use check::Plan;
 use glam::{DVec3, Vec3};
 use quadric::Quadric;
-use spatial::SpatialGrid;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap};
 
@@ -151,7 +150,7 @@ struct State<'a> {
     /// Per current feature edge, the original feature vertices it stands for (besides its ends).
     lines: HashMap<(u32, u32), Vec<DVec3>>,
     line_neighbours: Vec<Vec<u32>>,
-    grid: SpatialGrid,
+    grid: TriangleBuckets,
     heap: BinaryHeap<Candidate>,
     field: Option<&'a dyn Field>,
     options: DecimateOptions,
@@ -189,7 +188,7 @@ impl<'a> State<'a> {
             stamp: vec![0; n],
             lines: HashMap::new(),
             line_neighbours: vec![Vec::new(); n],
-            grid: SpatialGrid::new(1.0, tris.len()),
+            grid: TriangleBuckets::build(1.0, std::iter::empty()),
             heap: BinaryHeap::new(),
             alive_count: alive.iter().filter(|&&a| a).count(),
             pos,
@@ -348,10 +347,12 @@ impl<'a> State<'a> {
             }
         }
         let mean = if count > 0 { total / count as f64 } else { 1.0 };
-        self.grid = SpatialGrid::new(4.0 * mean, self.tris.len());
+        let boxes: Vec<(DVec3, DVec3)> =
+            (0..self.tris.len() as u32).map(|f| bounds(&self.corners(f))).collect();
+        self.grid = TriangleBuckets::build(4.0 * mean, boxes.into_iter());
         for f in 0..self.tris.len() as u32 {
-            if self.alive[f as usize] {
-                self.insert_face(f);
+            if !self.alive[f as usize] {
+                self.grid.remove(f);
             }
         }
     }
@@ -443,6 +444,7 @@ impl<'a> State<'a> {
     fn apply(&mut self, u: u32, v: u32, p: DVec3, plan: Plan) {
         for &f in &plan.removed {
             self.alive[f as usize] = false;
+            self.grid.remove(f);
             for w in self.tris[f as usize] {
                 if w != u && w != v {
                     self.faces_of[w as usize].retain(|&g| g != f);
@@ -543,10 +545,6 @@ impl<'a> State<'a> {
         feature_edges.sort_unstable();
         Decimated { mesh, feature_edges, collapses: self.collapses }
     }
-}
-
-fn bounds(c: &[DVec3; 3]) -> (DVec3, DVec3) {
-    (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
 }
 
 /// Smallest interior angle of a triangle, in radians (0 for a degenerate one).
