@@ -19,6 +19,13 @@ pub trait Field: Sync {
         None
     }
 
+    /// The value and [`Field::gradient`] at one point. Evaluators that get both from one pass
+    /// (the compiled programs' forward differentiation) override this: root finding along EMC's
+    /// edges wants both at every step.
+    fn value_and_gradient(&self, p: Vec3) -> (f32, Option<Vec3>) {
+        (self.value(p), self.gradient(p))
+    }
+
     /// Conservative bounds `(lo, hi)` of the value over the box `[lo, hi]`, where the field can give
     /// them (compiled expressions can): octrees use them to skip space the surface cannot reach.
     fn interval(&self, _lo: Vec3, _hi: Vec3) -> Option<(f32, f32)> {

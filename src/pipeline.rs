@@ -510,6 +510,10 @@ impl Field for Shifted<'_> {
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         self.field.gradient(p)
     }
+    fn value_and_gradient(&self, p: Vec3) -> (f32, Option<Vec3>) {
+        let (v, g) = self.field.value_and_gradient(p);
+        (v - self.iso, g)
+    }
 }
 
 #[cfg(test)]

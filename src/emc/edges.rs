@@ -42,8 +42,16 @@ pub struct FieldRoots<'a> {
 
 impl EdgeSampler for FieldRoots<'_> {
     fn crossing(&self, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Vec3) {
-        let t = if self.directed { edge_root(self.field, self.iso, a, b, da, db) } else { da / (da - db) };
-        (t, field_normal(self.field, a + (b - a) * t, self.h * 1e-3))
+        let (t, gradient) = if self.directed {
+            root_and_gradient(self.field, self.iso, a, b, da, db)
+        } else {
+            (da / (da - db), None)
+        };
+        let normal = match gradient {
+            Some(g) => g.normalize_or_zero(),
+            None => field_normal(self.field, a + (b - a) * t, self.h * 1e-3),
+        };
+        (t, normal)
     }
 
     fn crossing_on_segment(&self, a: Vec3, b: Vec3) -> Option<(f32, Vec3)> {
@@ -84,24 +92,26 @@ impl EdgeSampler for SampleInterpolation<'_> {
 /// Safeguarded Newton: a Newton step is taken only when it stays inside the current bracket,
 /// otherwise the bracket is bisected, so the iteration can never leave the edge and always converges.
 pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32) -> f32 {
+    root_and_gradient(field, iso, a, b, da, db).0
+}
+
+/// [`edge_root`], and the field's gradient at the root where the search ended on an evaluation
+/// there (it does but for a root clamped off the edge's ends or a search that ran out of steps).
+fn root_and_gradient(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Option<Vec3>) {
     let dir = b - a;
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
     // Keep lo on the inside side: g(lo) < 0 <= g(hi) after orienting.
-    let flip = da >= 0.0;
-    let g = |t: f32| -> f32 {
-        let v = field.value(a + dir * t) - iso;
-        if flip {
-            -v
-        } else {
-            v
-        }
-    };
-    let (mut glo, mut ghi) = if flip { (-da, -db) } else { (da, db) };
+    let sign = if da >= 0.0 { -1.0 } else { 1.0 };
+    let (mut glo, mut ghi) = (sign * da, sign * db);
     // Start from the linear estimate (regula falsi point), which is exact for linear fields.
     let mut t = glo / (glo - ghi);
     let mut width = 1.0f32;
+    let mut at_root = None;
     for _ in 0..48 {
-        let gt = g(t);
+        // Value and gradient in one evaluation: a compiled program's forward pass gives both.
+        let (v, grad) = field.value_and_gradient(a + dir * t);
+        at_root = grad;
+        let gt = sign * (v - iso);
         if gt == 0.0 {
             break;
         }
@@ -115,8 +125,9 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
         if hi - lo < 1e-6 {
             break;
         }
-        let slope = match field.gradient(a + dir * t) {
-            Some(grad) => grad.dot(dir) * if flip { -1.0 } else { 1.0 },
+        at_root = None;
+        let slope = match grad {
+            Some(grad) => grad.dot(dir) * sign,
             None => (ghi - glo) / (hi - lo),
         };
         let newton = t - gt / slope;
@@ -126,7 +137,8 @@ pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32
         width = hi - lo;
         t = if slope != 0.0 && newton > lo && newton < hi && !stalled { newton } else { 0.5 * (lo + hi) };
     }
-    t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION)
+    let clamped = t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
+    (clamped, at_root.filter(|_| clamped == t))
 }
 
 /// Unit normal of the field at `p`: its gradient, or central differences when it has none.

@@ -13,6 +13,11 @@ impl Field for Program {
         Some(self.eval_grad(p).1)
     }
 
+    fn value_and_gradient(&self, p: Vec3) -> (f32, Option<Vec3>) {
+        let (v, g) = self.eval_grad(p);
+        (v, Some(g))
+    }
+
     fn values(&self, points: &[Vec3], out: &mut [f32]) {
         self.eval_many(points, out);
     }

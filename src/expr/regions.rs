@@ -338,6 +338,11 @@ impl Field for RegionalProgram<'_> {
         Some(self.program_at(p).eval_grad(p).1)
     }
 
+    fn value_and_gradient(&self, p: Vec3) -> (f32, Option<Vec3>) {
+        let (v, g) = self.program_at(p).eval_grad(p);
+        (v, Some(g))
+    }
+
     fn values(&self, points: &[Vec3], out: &mut [f32]) {
         self.batched(points, out, |program, p, o| program.eval_many(p, o));
     }
