@@ -440,7 +440,8 @@ impl Work<'_> {
 /// larger worst angle), lie along the surface (within [`MAX_TURN_DEG`] of the true normal at a
 /// corner, or no worse than the worst triangle they replace), stay within the tolerance of the
 /// surface (or no farther than the old ones), and neither cross nor fold onto any triangle nearby
-/// (the analysis's exact tests, on the triangles in [`crate::mesh::buckets`] of finest cells).
+/// (the analysis's exact tests, on the triangles in [`crate::mesh::buckets`] of two finest cells,
+/// about a triangle's size).
 ///
 /// **Why it is bounded.** At most [`PASSES`] passes over the bad triangles, each change removing
 /// a vertex or replacing two triangles by better ones; the caller reports what it did.
@@ -485,7 +486,7 @@ pub fn improve(
         faces_of,
         fixed,
         nearby: crate::mesh::buckets::TriangleBuckets::build(
-            h as f64,
+            2.0 * h as f64,
             mesh.triangles
                 .iter()
                 .map(|t| crate::mesh::buckets::bounds(&t.map(|v| mesh.positions[v as usize].as_dvec3()))),
