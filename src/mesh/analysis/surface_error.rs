@@ -104,6 +104,7 @@ fn measure<E>(
         fd_step: (1e-4 * diagonal).max(1e-6) as f32,
         // Stop once steps are below what f32 evaluation can resolve at these coordinates.
         tolerance: (1e-7 * diagonal).max(4.0 * f32::EPSILON as f64 * largest_coordinate),
+        ridge_floor: 1e-3 * diagonal,
     };
 
     let mut sum_sq = 0.0;
@@ -197,6 +198,8 @@ struct Projector<'a> {
     field: &'a dyn Field,
     fd_step: f32,
     tolerance: f64,
+    /// Walks shorter than this are taken as they are (see [`Projector::project`]).
+    ridge_floor: f64,
 }
 
 impl Projector<'_> {
@@ -210,11 +213,49 @@ impl Projector<'_> {
         g.as_dvec3()
     }
 
-    /// Walks from `start` to the zero set (see [`surface_error`]).
+    /// The distance from `start` to the zero set, as the length of a Newton walk to it: an upper
+    /// bound, tight where the walk goes straight to the nearest point. On a ridge of a distance
+    /// field (the axis of a cone, the bisector inside a convex edge), where the gradient is the
+    /// mean of two sides', the walk can land far off the nearest point (on the apex from a point
+    /// on a cone's axis, three times the distance); there walks from points a little off `start`
+    /// along each axis, each plus that offset (still upper bounds), are tried too, and the
+    /// shortest kept, for walks longer than a thousandth of the mesh's diagonal.
     fn project(&self, start: DVec3) -> Projection {
+        let (straight, first) = self.walk(start);
+        let Some((f0, g0)) = first else { return straight };
+        // Near the surface the walk's overshoot is too small to matter (and ridges, at creases,
+        // are everywhere on CAD parts): only far samples are checked.
+        if !straight.converged || straight.distance < self.ridge_floor {
+            return straight;
+        }
+        let offset = (1e-2 * straight.distance).max(4.0 * self.fd_step as f64);
+        // One value a little aside tells a ridge: there the field departs from its tangent plane
+        // at first order (the gradient at `start` is the mean of the sides'), elsewhere at second.
+        let aside = DVec3::new(0.802, 0.496, 0.333) * offset;
+        let departure = self.field.value((start + aside).as_vec3()) as f64 - (f0 + g0.dot(aside));
+        if departure.abs() < 0.05 * g0.length() * offset {
+            return straight;
+        }
+        let mut best = straight;
+        for axis in 0..6 {
+            let mut step = DVec3::ZERO;
+            step[axis % 3] = if axis < 3 { offset } else { -offset };
+            let (mut aside, _) = self.walk(start + step);
+            aside.distance = (aside.point - start).length();
+            if aside.converged && aside.distance < best.distance {
+                best = aside;
+            }
+        }
+        best
+    }
+
+    /// Walks from `start` to the zero set with Newton steps along the gradient; also returns the
+    /// value and gradient at `start`, where the walk took a step.
+    fn walk(&self, start: DVec3) -> (Projection, Option<(f64, DVec3)>) {
         let mut p = start;
         let mut converged = false;
         let mut last_step = f64::INFINITY;
+        let mut first = None;
         for _ in 0..MAX_STEPS {
             let f = self.field.value(p.as_vec3()) as f64;
             if f == 0.0 {
@@ -226,6 +267,7 @@ impl Projector<'_> {
             if !(g2 > 0.0 && g2.is_finite() && f.is_finite()) {
                 break;
             }
+            first.get_or_insert((f, g));
             let step = g * (f / g2);
             p -= step;
             last_step = step.length();
@@ -236,7 +278,7 @@ impl Projector<'_> {
         }
         // A walk that is still taking small steps at the end has found the surface all the same.
         converged |= last_step <= 10.0 * self.tolerance;
-        Projection { point: p, distance: (p - start).length(), converged }
+        (Projection { point: p, distance: (p - start).length(), converged }, first)
     }
 }
 
@@ -245,6 +287,24 @@ mod tests {
     use super::*;
     use crate::mesh::analysis::fixtures::*;
     use crate::scenes::Sphere;
+
+    #[test]
+    fn a_point_on_a_cones_axis_is_as_far_as_the_side_not_the_apex() {
+        // Cone of base radius 0.16, apex at z = 0.45: on its axis the gradient is the mean of the
+        // side normals all around, a third of unit length, and a walk along it ends on the apex.
+        let cone = crate::expr::compile("cone(0.16, 0.45)").unwrap();
+        let z = 0.4f32;
+        let tiny = 1e-5;
+        let mesh = Mesh {
+            positions: vec![Vec3::new(0.0, 0.0, z), Vec3::new(tiny, 0.0, z), Vec3::new(0.0, tiny, z)],
+            normals: Vec::new(),
+            triangles: vec![[0, 1, 2]],
+        };
+        let e = surface_error(&mesh, &cone);
+        let half_angle = 0.16f64.atan2(0.45);
+        let side = 0.16 * (0.45 - z as f64) / 0.45 * half_angle.cos();
+        assert!((e.dist_max - side).abs() < 0.02 * side, "{} against {side}", e.dist_max);
+    }
 
     #[test]
     fn an_octahedron_inscribed_in_the_unit_sphere() {
