@@ -18,6 +18,15 @@ rustup_has_wasm() {
   command -v rustup >/dev/null 2>&1 && rustup target list --installed 2>/dev/null | grep -qx "$WASM_TARGET"
 }
 
+# debian_wasm_cargo TARGET_DIR SUBCOMMAND [ARGS...]: cargo for the wasm32 target on Debian's
+# toolchain, std rebuilt from its sources (../shared/TOOLCHAIN.md), with the caller's RUSTFLAGS.
+debian_wasm_cargo() {
+  local dir="$1" sub="$2"
+  shift 2
+  PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+    CARGO_TARGET_DIR="$dir" /usr/bin/cargo "$sub" --target "$WASM_TARGET" -Z build-std=std,panic_abort "$@"
+}
+
 # wasm_cargo SUBCOMMAND [ARGS...]: cargo for the wasm32 target, whichever way this machine allows.
 wasm_cargo() {
   local sub="$1"
@@ -25,9 +34,7 @@ wasm_cargo() {
   if rustup_has_wasm; then
     CARGO_TARGET_DIR="$WASM_TARGET_DIR" cargo "$sub" --target "$WASM_TARGET" "$@"
   else
-    PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
-      CARGO_TARGET_DIR="$WASM_TARGET_DIR" \
-      /usr/bin/cargo "$sub" --target "$WASM_TARGET" -Z build-std=std,panic_abort "$@"
+    debian_wasm_cargo "$WASM_TARGET_DIR" "$sub" "$@"
   fi
 }
 
@@ -48,9 +55,7 @@ wasm_threads_cargo() {
   if rustup_has_wasm; then
     return 2
   fi
-  PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
-    RUSTFLAGS="$WASM_THREADS_RUSTFLAGS" CARGO_TARGET_DIR="$WASM_THREADS_TARGET_DIR" \
-    /usr/bin/cargo "$sub" --target "$WASM_TARGET" -Z build-std=std,panic_abort "$@"
+  RUSTFLAGS="$WASM_THREADS_RUSTFLAGS" debian_wasm_cargo "$WASM_THREADS_TARGET_DIR" "$sub" "$@"
 }
 
 # The exact wasm-bindgen version the crate links against; the CLI must match it.

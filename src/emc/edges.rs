@@ -89,14 +89,23 @@ impl EdgeSampler for SampleInterpolation<'_> {
 /// Root of `f - iso` on the segment `a..b`, given the signed values `da = f(a) - iso < 0 <= db` (or
 /// the reverse), as a fraction `t` of the way from `a` to `b`.
 ///
-/// Safeguarded Newton: a Newton step is taken only when it stays inside the current bracket,
-/// otherwise the bracket is bisected, so the iteration can never leave the edge and always converges.
+/// Safeguarded Newton (Numerical Recipes' `rtsafe`): a Newton step is taken only when it stays
+/// inside the current bracket and is less than half the step before it, otherwise the bracket is
+/// bisected, so the iteration can never leave the edge and always converges, and a kink that
+/// slows Newton down (a min or max of two parts) costs bisections, not a crawl.
 pub fn edge_root(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32) -> f32 {
     root_and_gradient(field, iso, a, b, da, db).0
 }
 
-/// [`edge_root`], and the field's gradient at the root where the search ended on an evaluation
-/// there (it does but for a root clamped off the edge's ends or a search that ran out of steps).
+/// Steps (in fractions of the edge) below which the root is taken as found: on a cell edge of
+/// 1/64 of the unit cube, 1.6e-7 in space, a couple of f32 ulps at coordinates near 1, where the
+/// values' rounding makes Newton's last steps wander.
+const ROOT_STEP: f32 = 1e-5;
+
+/// [`edge_root`], and the field's gradient at the last point evaluated where that lies within
+/// [`ROOT_STEP`] of the root returned (the normal there differs from the root's by the
+/// surface's turn over that step); `None` for a root clamped off the edge's ends or a search that
+/// ran out of steps.
 fn root_and_gradient(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db: f32) -> (f32, Option<Vec3>) {
     let dir = b - a;
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
@@ -105,14 +114,14 @@ fn root_and_gradient(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db:
     let (mut glo, mut ghi) = (sign * da, sign * db);
     // Start from the linear estimate (regula falsi point), which is exact for linear fields.
     let mut t = glo / (glo - ghi);
-    let mut width = 1.0f32;
+    let mut step = 1.0f32;
     let mut at_root = None;
     for _ in 0..48 {
         // Value and gradient in one evaluation: a compiled program's forward pass gives both.
         let (v, grad) = field.value_and_gradient(a + dir * t);
-        at_root = grad;
         let gt = sign * (v - iso);
         if gt == 0.0 {
+            at_root = grad;
             break;
         }
         if gt < 0.0 {
@@ -122,20 +131,19 @@ fn root_and_gradient(field: &dyn Field, iso: f32, a: Vec3, b: Vec3, da: f32, db:
             hi = t;
             ghi = gt;
         }
-        if hi - lo < 1e-6 {
-            break;
-        }
-        at_root = None;
         let slope = match grad {
             Some(grad) => grad.dot(dir) * sign,
             None => (ghi - glo) / (hi - lo),
         };
         let newton = t - gt / slope;
-        // Bisect when Newton leaves the bracket or when the bracket stopped halving (the one-sided
-        // stall of secant-like steps), so convergence is guaranteed.
-        let stalled = hi - lo > 0.5 * width;
-        width = hi - lo;
-        t = if slope != 0.0 && newton > lo && newton < hi && !stalled { newton } else { 0.5 * (lo + hi) };
+        let fast = slope != 0.0 && newton > lo && newton < hi && 2.0 * (newton - t).abs() < step;
+        let next = if fast { newton } else { 0.5 * (lo + hi) };
+        step = (next - t).abs();
+        t = next;
+        if step < ROOT_STEP || hi - lo < ROOT_STEP {
+            at_root = grad;
+            break;
+        }
     }
     let clamped = t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
     (clamped, at_root.filter(|_| clamped == t))
@@ -162,6 +170,56 @@ mod tests {
         // Reversed orientation gives the same point.
         let t2 = edge_root(&sphere, 0.0, b, a, db, da);
         assert!(((a + (b - a) * t) - (b + (a - b) * t2)).length() < 1e-6);
+    }
+
+    /// A field that counts its evaluations.
+    struct Counted<'a> {
+        field: &'a dyn Field,
+        evaluations: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Field for Counted<'_> {
+        fn value(&self, p: Vec3) -> f32 {
+            self.evaluations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.field.value(p)
+        }
+        fn gradient(&self, p: Vec3) -> Option<Vec3> {
+            self.field.gradient(p)
+        }
+        fn value_and_gradient(&self, p: Vec3) -> (f32, Option<Vec3>) {
+            (self.value(p), self.gradient(p))
+        }
+    }
+
+    /// On a smooth surface Newton from the regula falsi point is mostly done in two evaluations
+    /// (the second finds a step under [`ROOT_STEP`]), where a test on the bracket's shrinking
+    /// bisected the first step and took 3.7 on average; f32 rounding near the root costs one or
+    /// two more now and then (measured: 171 of 200 roots in 2, 26 in 3, 2 in 4).
+    #[test]
+    fn root_finding_on_a_smooth_surface_takes_about_two_evaluations() {
+        let sphere = Sphere { center: Vec3::ZERO, radius: 0.8 };
+        let counted = Counted { field: &sphere, evaluations: Default::default() };
+        let mut rng = crate::expr::testutil::Rng::new(3);
+        let (mut roots, mut most, mut total) = (0, 0, 0);
+        while roots < 200 {
+            let a = rng.vec3(-1.0, 1.0);
+            let b = a + rng.vec3(-0.05, 0.05);
+            let (da, db) = (sphere.value(a), sphere.value(b));
+            if (da < 0.0) == (db < 0.0) {
+                continue;
+            }
+            roots += 1;
+            counted.evaluations.store(0, std::sync::atomic::Ordering::Relaxed);
+            let (t, gradient) = root_and_gradient(&counted, 0.0, a, b, da, db);
+            let p = a + (b - a) * t;
+            assert!(sphere.value(p).abs() < 1e-6, "{p}");
+            assert!(gradient.is_some(), "the gradient at the root comes with it");
+            let n = counted.evaluations.load(std::sync::atomic::Ordering::Relaxed);
+            most = most.max(n);
+            total += n;
+        }
+        assert!(total as f64 / roots as f64 <= 2.3, "{total} evaluations for {roots} roots");
+        assert!(most <= 5, "{most} evaluations");
     }
 
     #[test]
