@@ -7,24 +7,15 @@ depth 6, its finest cells the same size).
     cargo build --release && python3 scripts/methods_table.py
 """
 
-import json
-import subprocess
+from error_curve import stats as cli_stats
 
-BIN = "target/release/isoforge"
 SCENES = ["sphere", "cube_minus_sphere", "fandisk", "rocket", "thin_room", "gear"]
 METHODS = ["mc", "emc", "dmc"]
 RUNS = 3
 
 
 def stats(scene, method):
-    out = subprocess.run(
-        [BIN, "mesh", "--scene", scene, "--method", method, "--res", "64", "--threads", "1", "--stats",
-         "--no-intersections"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
-    return json.loads(out)
+    return cli_stats(scene, ["--method", method, "--res", "64", "--threads", "1"])
 
 
 def thousands(n):
@@ -32,7 +23,8 @@ def thousands(n):
 
 
 def main():
-    print("| scene | " + " | ".join(f"{m.upper()}: triangles · max distance · ms" for m in METHODS) + " |")
+    header = " | ".join(f"{m.upper()}: triangles · max distance · ms" for m in METHODS)
+    print(f"| scene | {header} |")
     print("|---" + "|---:" * len(METHODS) + "|")
     for scene in SCENES:
         cells = []

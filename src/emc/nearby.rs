@@ -40,12 +40,11 @@ impl NearbyTriangles {
         self.buckets.remove(t);
     }
 
-    /// Every recorded triangle whose buckets overlap the box of `corners`, each once, ascending.
+    /// Every recorded triangle whose box overlaps the box of `corners`, each once.
     pub fn near(&mut self, corners: &[Vec3; 3]) -> Vec<u32> {
         let (lo, hi) = bounds(&corners64(corners));
         let mut out = Vec::new();
         self.buckets.query(lo, hi, &mut out);
-        out.sort_unstable();
         out
     }
 

@@ -2,9 +2,9 @@
 //! triangle whose bounding box is no wider than a cube is recorded once, in the cube that holds
 //! its box's low corner; a larger one in every cube its box overlaps. A query looks at the cubes
 //! its box overlaps and those below as far as the widest small box reaches (where low corners of
-//! small overlapping boxes can lie) and reports the recorded boxes that overlap its own. EMC's flips and
-//! pull-backs, DMC's sliver pass and decimation each ask it, before they change a mesh, which
-//! triangles a new one could cross.
+//! small overlapping boxes can lie) and reports the recorded boxes that overlap its own. EMC's
+//! flips and pull-backs, DMC's sliver pass and decimation each ask it, before they change a mesh,
+//! which triangles a new one could cross.
 //!
 //! The triangles given at the start are one list of (cube, triangle) sorted by cube, so building
 //! it is one sort and a query a binary search per cube; only the few triangles changed afterwards

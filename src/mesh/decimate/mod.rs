@@ -18,9 +18,9 @@
 //! edge orientations (the mesh stays a closed oriented 2-manifold of the same Euler
 //! characteristic), no face turned by more than [`DecimateOptions::max_normal_turn_deg`], no
 //! degenerate faces, no new angle below [`DecimateOptions::min_angle_deg`] unless the faces it
-//! replaces were already worse, no crossing with any face nearby ([`crate::mesh::buckets`] of the faces and
-//! the analysis's exact triangle-pair test), and with a field, no new vertex or face sample
-//! farther than [`DecimateOptions::max_error`] from the zero set.
+//! replaces were already worse, no crossing with any face nearby ([`crate::mesh::buckets`] of
+//! the faces and the analysis's exact triangle-pair test), and with a field, no new vertex or face
+//! sample farther than [`DecimateOptions::max_error`] from the zero set.
 
 mod check;
 mod flip;
