@@ -36,12 +36,7 @@ pub fn merge_flat_crossings(
     h: f32,
 ) -> usize {
     let n = mesh.positions.len();
-    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        for &v in tri {
-            incident[v as usize].push(t as u32);
-        }
-    }
+    let mut incident = incident_triangles(mesh);
     let mut dead = vec![false; mesh.triangles.len()];
     let mut removed = vec![false; n];
     let tolerance = FLAT_TOLERANCE * h;
@@ -66,6 +61,99 @@ pub fn merge_flat_crossings(
         compact(mesh, [fan_centre, feature_vertex], crease, &removed, &dead);
     }
     merged
+}
+
+/// Fan centres closer than this (in cells) that fan the same polygon edge from both sides are one
+/// feature point: two centres kept [`super::placement`]'s inset (a hundredth of a cell) off a
+/// shared cell face are 0.02 cells apart.
+pub const WELD_DISTANCE: f32 = 0.05;
+
+/// Welds pairs of fan centres that stand for one feature point lying in the cell face between
+/// them, and drops the two triangles they fold back to back. Where a feature point (a cone's apex,
+/// a corner) lies in a grid plane, both cells beside it place their centre on it, each kept a
+/// hundredth of a cell inside its own cell, and both fan the edge their polygons share in that
+/// face: two triangles lying in the face, one on top of the other, turned 90° from a surface that
+/// crosses the face (a fin on the cube with cut-outs, whose countersink's apex lies in a grid
+/// plane at 32, 48, 64 and 128 cells). One vertex on the face serves both fans, and the two
+/// triangles, then the same triangle twice in opposite orientations, cover nothing.
+///
+/// Welded only under the link condition (the two centres share exactly the edge's two ends as
+/// neighbours and are not joined), so the surface keeps its topology and stays manifold; the
+/// vertex goes to the midpoint (on the face). Compacts like [`merge_flat_crossings`]; returns
+/// how many pairs it welded.
+pub fn weld_facing_centres(
+    mesh: &mut Mesh,
+    fan_centre: &mut Vec<bool>,
+    feature_vertex: &mut Vec<bool>,
+    crease: &mut Vec<Vec3>,
+    h: f32,
+) -> usize {
+    let mut incident = incident_triangles(mesh);
+    // The edges between crossings, with the triangle on each side: sorted, an edge's two
+    // triangles are neighbours in the list.
+    let mut edges: Vec<((u32, u32), u32)> = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if !fan_centre[a as usize] && !fan_centre[b as usize] {
+                edges.push(((a.min(b), a.max(b)), t as u32));
+            }
+        }
+    }
+    edges.sort_unstable();
+    let mut dead = vec![false; mesh.triangles.len()];
+    let mut removed = vec![false; mesh.positions.len()];
+    let mut welded = 0;
+    for pair in edges.windows(2) {
+        let [(e, t1), (f, t2)] = [pair[0], pair[1]];
+        if e != f || dead[t1 as usize] || dead[t2 as usize] {
+            continue;
+        }
+        let apex = |t: u32| mesh.triangles[t as usize].into_iter().find(|&v| v != e.0 && v != e.1);
+        let (Some(c1), Some(c2)) = (apex(t1), apex(t2)) else { continue };
+        let (p1, p2) = (mesh.positions[c1 as usize], mesh.positions[c2 as usize]);
+        if c1 == c2
+            || !fan_centre[c1 as usize]
+            || !fan_centre[c2 as usize]
+            || p1.distance(p2) > WELD_DISTANCE * h
+        {
+            continue;
+        }
+        let (ring1, ring2) = (ring(mesh, &incident[c1 as usize], c1), ring(mesh, &incident[c2 as usize], c2));
+        let common: Vec<u32> = ring1.iter().copied().filter(|v| ring2.binary_search(v).is_ok()).collect();
+        if common != [e.0, e.1] || ring1.binary_search(&c2).is_ok() {
+            continue;
+        }
+        for t in [t1, t2] {
+            dead[t as usize] = true;
+            for v in mesh.triangles[t as usize] {
+                incident[v as usize].retain(|&u| u != t);
+            }
+        }
+        for t in std::mem::take(&mut incident[c2 as usize]) {
+            mesh.triangles[t as usize].iter_mut().filter(|v| **v == c2).for_each(|v| *v = c1);
+            incident[c1 as usize].push(t);
+        }
+        mesh.positions[c1 as usize] = (p1 + p2) * 0.5;
+        feature_vertex[c1 as usize] |= feature_vertex[c2 as usize];
+        removed[c2 as usize] = true;
+        welded += 1;
+    }
+    if welded > 0 {
+        compact(mesh, [fan_centre, feature_vertex], crease, &removed, &dead);
+    }
+    welded
+}
+
+/// Per vertex, the triangles that use it.
+fn incident_triangles(mesh: &Mesh) -> Vec<Vec<u32>> {
+    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            incident[v as usize].push(t as u32);
+        }
+    }
+    incident
 }
 
 /// The vertices joined to `v` by the triangles `tris` (each once).

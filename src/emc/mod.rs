@@ -243,6 +243,13 @@ pub fn mesh_with_sampler(
             grid.cell_size(),
         );
     }
+    merge::weld_facing_centres(
+        &mut out.mesh,
+        &mut centres.any,
+        &mut out.feature_vertex,
+        &mut centres.crease,
+        grid.cell_size(),
+    );
     out.feature_edges =
         lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex, &centres.crease, grid.cell_size());
     timings.flip_ms = ms_since(t2);
