@@ -122,7 +122,7 @@ impl DualColumn {
     }
 
     fn lane(&self, l: usize) -> Dual {
-        Dual { v: self.v[l], d: Vec3::new(self.d[0][l], self.d[1][l], self.d[2][l]) }
+        Dual { v: self.v[l], d: glam::Vec3A::new(self.d[0][l], self.d[1][l], self.d[2][l]) }
     }
 
     fn set_lane(&mut self, l: usize, dual: Dual) {
@@ -148,7 +148,7 @@ pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wra
             }
         },
         run_dual_column,
-        |col, out| out.iter_mut().enumerate().for_each(|(l, o)| *o = wrap(col.lane(l).d)),
+        |col, out| out.iter_mut().enumerate().for_each(|(l, o)| *o = wrap(col.lane(l).d.into())),
     );
 }
 
