@@ -346,4 +346,59 @@ mod tests {
             0
         );
     }
+
+    /// Two fans either side of the plane z = 0, centres 0.02 apart, sharing the edge (a, b) in
+    /// it: the fan above over (a, b, p), the one below over (b, a, r).
+    fn back_to_back_fans() -> Mesh {
+        // 0: a, 1: b, 2: p (above), 3: r (below), 4: centre above, 5: centre below.
+        let positions = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 1.0, 1.0],
+            [0.5, 1.0, -1.0],
+            [0.5, 0.3, 0.01],
+            [0.5, 0.3, -0.01],
+        ];
+        let triangles = [[4, 0, 1], [4, 1, 2], [4, 2, 0], [5, 1, 0], [5, 0, 3], [5, 3, 1]];
+        fixtures::mesh(&positions, &triangles)
+    }
+
+    #[test]
+    fn fan_centres_back_to_back_across_a_face_are_welded_on_it() {
+        let mut mesh = back_to_back_fans();
+        let before = topology(&mesh);
+        let (mut centre, mut feature) = (vec![false, false, false, false, true, true], vec![false; 6]);
+        feature[5] = true;
+        let mut crease = vec![Vec3::ZERO; 6];
+        assert_eq!(weld_facing_centres(&mut mesh, &mut centre, &mut feature, &mut crease, 1.0), 1);
+        assert_eq!((mesh.vertex_count(), mesh.triangle_count()), (5, 4));
+        assert_eq!(centre, [false, false, false, false, true]);
+        assert_eq!(feature, [false, false, false, false, true], "the weld keeps either's feature flag");
+        assert_eq!(mesh.positions[4], Vec3::new(0.5, 0.3, 0.0), "the welded vertex lies on the face");
+        assert!(mesh.triangles.iter().all(|t| t.contains(&4)), "one fan around it");
+        let after = topology(&mesh);
+        assert_eq!((after.euler, after.boundary_edges), (before.euler, before.boundary_edges));
+        assert_eq!(after.non_manifold_edges, 0);
+    }
+
+    #[test]
+    fn fan_centres_too_far_apart_or_sharing_more_than_the_edge_stay() {
+        let mut far = back_to_back_fans();
+        far.positions[5].z = -0.2;
+        let (mut centre, mut feature) = (vec![false, false, false, false, true, true], vec![false; 6]);
+        assert_eq!(
+            weld_facing_centres(&mut far, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 6], 1.0),
+            0
+        );
+        // Both fans over the same triangle (a, b, p): welding would leave two triangles on one
+        // edge pair, a closed pillow flattened.
+        let mut pillow = fixtures::mesh(
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, 0.3, 0.01], [0.5, 0.3, -0.01]],
+            &[[3, 0, 1], [3, 1, 2], [3, 2, 0], [4, 1, 0], [4, 2, 1], [4, 0, 2]],
+        );
+        let (mut centre, mut feature) = (vec![false, false, false, true, true], vec![false; 5]);
+        let welded =
+            weld_facing_centres(&mut pillow, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 5], 1.0);
+        assert_eq!((welded, pillow.triangle_count()), (0, 6));
+    }
 }
