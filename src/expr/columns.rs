@@ -14,8 +14,23 @@ pub const LANES: usize = 64;
 
 type Column = [f32; LANES];
 
+/// Batches smaller than this run point by point: a column pass costs all its lanes and the
+/// columns' setup (a column per slot, constants filled) however few points it holds, so a handful
+/// of points, as a batch split by brick ([`super::RegionalProgram`]) leaves, are cheaper one at a
+/// time through the point interpreter, which gives the same bits.
+pub const SMALL_BATCH: usize = 8;
+
+/// [`SMALL_BATCH`] for gradients, whose columns are four times the size.
+pub const SMALL_GRADIENT_BATCH: usize = 16;
+
 /// Values at many points; only the first `min(points.len(), out.len())` are written.
 pub fn eval_columns(tape: &Tape, points: &[Vec3], out: &mut [f32]) {
+    if points.len().min(out.len()) < SMALL_BATCH {
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = super::eval::eval_point(tape, p);
+        }
+        return;
+    }
     run_columns(
         tape,
         points,
@@ -137,6 +152,12 @@ impl DualColumn {
 /// each passed through `wrap` (callers that want `Option`s need no second buffer); only the
 /// first `min(points.len(), out.len())` are written.
 pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wrap: impl Fn(Vec3) -> O) {
+    if points.len().min(out.len()) < SMALL_GRADIENT_BATCH {
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = wrap(super::eval::eval_gradient(tape, p).1);
+        }
+        return;
+    }
     run_columns(
         tape,
         points,
