@@ -46,6 +46,14 @@ pub trait Field: Sync {
             *o = self.gradient(*p);
         }
     }
+
+    /// [`Field::values`] and [`Field::gradients`] at the same points. Evaluators that get both
+    /// from one pass (the compiled programs' forward differentiation) override this: DMC takes
+    /// both at every sample of its crust and at every point of its distance tests.
+    fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
+        self.values(points, values);
+        self.gradients(points, gradients);
+    }
 }
 
 /// Any `Fn(Vec3) -> f32` closure is a field (without a gradient).

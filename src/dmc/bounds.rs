@@ -72,21 +72,15 @@ impl Clipped<'_> {
 
 impl Clipped<'_> {
     /// Values and gradients (central differences of step `h` where the field has none) at many
-    /// points, each of the field's batches called once.
-    pub fn values_and_gradients(&self, points: &[Vec3], h: f32) -> (Vec<f32>, Vec<Vec3>) {
-        let mut raw = vec![0.0; points.len()];
-        self.field.values(points, &mut raw);
+    /// points, in one of the field's batches.
+    pub fn values_and_gradients_or_differences(&self, points: &[Vec3], h: f32) -> (Vec<f32>, Vec<Vec3>) {
+        let mut values = vec![0.0; points.len()];
         let mut exact = vec![None; points.len()];
-        self.field.gradients(points, &mut exact);
-        let values = raw.iter().zip(points).map(|(&v, &p)| self.combine(v, p)).collect();
-        let gradients = raw
+        Field::values_and_gradients(self, points, &mut values, &mut exact);
+        let gradients = points
             .iter()
-            .zip(points)
             .zip(&exact)
-            .map(|((&v, &p), &g)| {
-                self.combine_gradient(v, g, p)
-                    .unwrap_or_else(|| crate::field::finite_difference_gradient(self, p, h))
-            })
+            .map(|(&p, &g)| g.unwrap_or_else(|| crate::field::finite_difference_gradient(self, p, h)))
             .collect();
         (values, gradients)
     }
@@ -140,11 +134,15 @@ impl Field for Clipped<'_> {
     }
 
     fn gradients(&self, points: &[Vec3], out: &mut [Option<Vec3>]) {
-        self.field.gradients(points, out);
         let mut values = vec![0.0; points.len()];
-        self.field.values(points, &mut values);
-        for ((o, &p), &v) in out.iter_mut().zip(points).zip(&values) {
-            *o = self.combine_gradient(v, *o, p);
+        self.values_and_gradients(points, &mut values, out);
+    }
+
+    fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
+        self.field.values_and_gradients(points, values, gradients);
+        for ((v, g), &p) in values.iter_mut().zip(gradients.iter_mut()).zip(points) {
+            *g = self.combine_gradient(*v, *g, p);
+            *v = self.combine(*v, p);
         }
     }
 }

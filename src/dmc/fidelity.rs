@@ -14,7 +14,7 @@ use super::contour::{batch_roots, Segment};
 use super::dual::VertexKey;
 use super::safety::EdgeTriangle;
 use super::tree::{Kind, Octree};
-use crate::field::{gradients_or_differences, Field};
+use crate::field::{finite_difference_gradient, Field};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -75,9 +75,14 @@ impl<'a> Fidelity<'a> {
             samples.push(ids);
         }
         let mut values = vec![0.0; self.points.len()];
-        self.field.values(&self.points, &mut values);
-        let (mut scratch, mut gradients) = (Vec::new(), Vec::new());
-        gradients_or_differences(self.field, &self.points, tree.h * 1e-2, &mut scratch, &mut gradients);
+        let mut exact = vec![None; self.points.len()];
+        self.field.values_and_gradients(&self.points, &mut values, &mut exact);
+        let gradients: Vec<Vec3> = self
+            .points
+            .iter()
+            .zip(&exact)
+            .map(|(&p, &g)| g.unwrap_or_else(|| finite_difference_gradient(self.field, p, tree.h * 1e-2)))
+            .collect();
         let close: Vec<bool> = values
             .iter()
             .zip(&gradients)

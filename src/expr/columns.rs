@@ -148,13 +148,14 @@ impl DualColumn {
     }
 }
 
-/// Gradients at many points (see [`super::eval::eval_gradient`] for the conventions at kinks),
-/// each passed through `wrap` (callers that want `Option`s need no second buffer); only the
+/// Values and gradients at many points (see [`super::eval::eval_gradient`] for the conventions
+/// at kinks), each pair passed through `wrap` (callers that want `Option`s need no second buffer); only the
 /// first `min(points.len(), out.len())` are written.
-pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wrap: impl Fn(Vec3) -> O) {
+pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wrap: impl Fn(f32, Vec3) -> O) {
     if points.len().min(out.len()) < SMALL_GRADIENT_BATCH {
         for (o, &p) in out.iter_mut().zip(points) {
-            *o = wrap(super::eval::eval_gradient(tape, p).1);
+            let (v, g) = super::eval::eval_gradient(tape, p);
+            *o = wrap(v, g);
         }
         return;
     }
@@ -169,7 +170,14 @@ pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wra
             }
         },
         run_dual_column,
-        |col, out| out.iter_mut().enumerate().for_each(|(l, o)| *o = wrap(col.lane(l).d.into())),
+        |col, out| {
+            out.iter_mut().enumerate().for_each(|(l, o)| {
+                *o = {
+                    let lane = col.lane(l);
+                    wrap(lane.v, lane.d.into())
+                }
+            })
+        },
     );
 }
 
@@ -284,6 +292,25 @@ mod tests {
                 assert!(equal, "{case} at {p}: column {g} vs point {e}");
             }
             assert!(out[points.len()..].iter().all(|g| g.x.is_nan()), "wrote past the points");
+        }
+    }
+
+    /// Values and gradients in one pass are the point interpreter's, for batches above and below
+    /// the size where batches run point by point.
+    #[test]
+    fn values_with_gradients_equal_pointwise_values_and_gradients_bit_for_bit() {
+        for case in CASES {
+            let program = compile(case).unwrap();
+            for n in [3, 150] {
+                let points = &points(7)[..n];
+                let mut out = vec![(f32::NAN, Vec3::splat(f32::NAN)); n];
+                program.eval_value_grad_many(points, &mut out);
+                for (p, (v, g)) in points.iter().zip(&out) {
+                    let (ev, eg) = program.eval_grad(*p);
+                    assert!(same(ev, program.eval(*p)) && same(*v, ev), "{case} at {p}: {v} vs {ev}");
+                    assert!((0..3).all(|i| same(eg[i], g[i])), "{case} at {p}: {g} vs {eg}");
+                }
+            }
         }
     }
 }

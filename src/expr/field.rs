@@ -26,6 +26,14 @@ impl Field for Program {
         self.eval_grad_many_as(points, out, Some);
     }
 
+    fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
+        let mut both = vec![(0.0, Vec3::ZERO); points.len().min(values.len()).min(gradients.len())];
+        self.eval_value_grad_many(points, &mut both);
+        for ((v, g), (bv, bg)) in values.iter_mut().zip(gradients.iter_mut()).zip(both) {
+            (*v, *g) = (bv, Some(bg));
+        }
+    }
+
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
         Some(self.eval_interval(lo, hi))
     }

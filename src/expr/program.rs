@@ -86,12 +86,18 @@ impl Program {
     /// Gradients at many points, 64 at a time, bit for bit [`Program::eval_grad`]'s. Writes
     /// `min(points.len(), out.len())` gradients.
     pub fn eval_grad_many(&self, points: &[Vec3], out: &mut [Vec3]) {
-        eval_gradient_columns(&self.tape, points, out, |g| g);
+        eval_gradient_columns(&self.tape, points, out, |_, g| g);
     }
 
     /// [`Program::eval_grad_many`] with each gradient passed through `wrap`.
     pub(super) fn eval_grad_many_as<O>(&self, points: &[Vec3], out: &mut [O], wrap: impl Fn(Vec3) -> O) {
-        eval_gradient_columns(&self.tape, points, out, wrap);
+        eval_gradient_columns(&self.tape, points, out, |_, g| wrap(g));
+    }
+
+    /// Values and gradients at many points in one pass, bit for bit [`Program::eval_grad`]'s
+    /// (whose value is [`Program::eval`]'s).
+    pub fn eval_value_grad_many(&self, points: &[Vec3], out: &mut [(f32, Vec3)]) {
+        eval_gradient_columns(&self.tape, points, out, |v, g| (v, g));
     }
 
     /// A shorter program equal to this one wherever `choices` hold (typically inside the box

@@ -351,6 +351,14 @@ impl Field for RegionalProgram<'_> {
         self.batched(points, out, |program, p, o| program.gradients(p, o));
     }
 
+    fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
+        let mut both = vec![(0.0, Vec3::ZERO); points.len().min(values.len()).min(gradients.len())];
+        self.batched(points, &mut both, |program, p, o| program.eval_value_grad_many(p, o));
+        for ((v, g), (bv, bg)) in values.iter_mut().zip(gradients.iter_mut()).zip(both) {
+            (*v, *g) = (bv, Some(bg));
+        }
+    }
+
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
         Some(self.program_over(lo, hi).eval_interval(lo, hi))
     }
@@ -383,6 +391,8 @@ mod tests {
             regional.values(&points, &mut batch);
             let mut grads = vec![None; points.len()];
             regional.gradients(&points, &mut grads);
+            let (mut both_values, mut both_grads) = (vec![0.0; points.len()], vec![None; points.len()]);
+            regional.values_and_gradients(&points, &mut both_values, &mut both_grads);
             for (i, &p) in points.iter().enumerate() {
                 let (v, g) = program.eval_grad(p);
                 let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
@@ -394,6 +404,9 @@ mod tests {
                     assert!(same(rg[axis], g[axis]) && same(bg[axis], g[axis]), "gradient at {p}");
                 }
                 assert!(same(regional.value(p), v));
+                assert!(same(both_values[i], v), "value in one pass with the gradient at {p}");
+                let both = both_grads[i].unwrap();
+                assert!((0..3).all(|axis| same(both[axis], g[axis])), "gradient in one pass at {p}");
             }
         }
     }
