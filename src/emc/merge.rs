@@ -8,6 +8,7 @@
 //! At most one collapse per fan centre, so the mesh stays as fine as MC's away from features and
 //! no long triangles grow from the creases.
 
+use super::placement::INSET;
 use crate::mesh::Mesh;
 use glam::Vec3;
 
@@ -63,30 +64,26 @@ pub fn merge_flat_crossings(
     merged
 }
 
-/// Fan centres closer than this (in cells) that fan the same polygon edge from both sides are one
-/// feature point: two centres kept [`super::placement`]'s inset (a hundredth of a cell) off a
-/// shared cell face are 0.02 cells apart.
-pub const WELD_DISTANCE: f32 = 0.05;
-
 /// Welds pairs of fan centres that stand for one feature point lying in the cell face between
 /// them, and drops the two triangles they fold back to back. Where a feature point (a cone's apex,
-/// a corner) lies in a grid plane, both cells beside it place their centre on it, each kept a
-/// hundredth of a cell inside its own cell, and both fan the edge their polygons share in that
+/// a corner) lies in a grid plane, both cells beside it place their centre on it, each kept
+/// [`INSET`] of a cell inside its own cell, and both fan the edge their polygons share in that
 /// face: two triangles lying in the face, one on top of the other, turned 90° from a surface that
 /// crosses the face (a fin on the cube with cut-outs, whose countersink's apex lies in a grid
 /// plane at 32, 48, 64 and 128 cells). One vertex on the face serves both fans, and the two
 /// triangles, then the same triangle twice in opposite orientations, cover nothing.
 ///
-/// Welded only under the link condition (the two centres share exactly the edge's two ends as
-/// neighbours and are not joined), so the surface keeps its topology and stays manifold; the
-/// vertex goes to the midpoint (on the face). Compacts like [`merge_flat_crossings`]; returns
-/// how many pairs it welded.
+/// Only that configuration is welded: the two centres differ along one axis alone, by at most
+/// two insets and a quarter of the grid's spacing there, with a grid plane between them, where
+/// the vertex goes; and under the link condition (they share exactly the edge's two ends as
+/// neighbours and are not joined), so the surface keeps its topology and stays manifold.
+/// Compacts like [`merge_flat_crossings`]; returns how many pairs it welded.
 pub fn weld_facing_centres(
     mesh: &mut Mesh,
     fan_centre: &mut Vec<bool>,
     feature_vertex: &mut Vec<bool>,
     crease: &mut Vec<Vec3>,
-    h: f32,
+    grid: (Vec3, Vec3),
 ) -> usize {
     let mut incident = incident_triangles(mesh);
     // The edges between crossings, with the triangle on each side: sorted, an edge's two
@@ -112,13 +109,10 @@ pub fn weld_facing_centres(
         let apex = |t: u32| mesh.triangles[t as usize].into_iter().find(|&v| v != e.0 && v != e.1);
         let (Some(c1), Some(c2)) = (apex(t1), apex(t2)) else { continue };
         let (p1, p2) = (mesh.positions[c1 as usize], mesh.positions[c2 as usize]);
-        if c1 == c2
-            || !fan_centre[c1 as usize]
-            || !fan_centre[c2 as usize]
-            || p1.distance(p2) > WELD_DISTANCE * h
-        {
+        if c1 == c2 || !fan_centre[c1 as usize] || !fan_centre[c2 as usize] {
             continue;
         }
+        let Some(on_face) = across_one_grid_plane(p1, p2, grid) else { continue };
         let (ring1, ring2) = (ring(mesh, &incident[c1 as usize], c1), ring(mesh, &incident[c2 as usize], c2));
         let common: Vec<u32> = ring1.iter().copied().filter(|v| ring2.binary_search(v).is_ok()).collect();
         if common != [e.0, e.1] || ring1.binary_search(&c2).is_ok() {
@@ -134,7 +128,7 @@ pub fn weld_facing_centres(
             mesh.triangles[t as usize].iter_mut().filter(|v| **v == c2).for_each(|v| *v = c1);
             incident[c1 as usize].push(t);
         }
-        mesh.positions[c1 as usize] = (p1 + p2) * 0.5;
+        mesh.positions[c1 as usize] = on_face;
         feature_vertex[c1 as usize] |= feature_vertex[c2 as usize];
         removed[c2 as usize] = true;
         welded += 1;
@@ -143,6 +137,26 @@ pub fn weld_facing_centres(
         compact(mesh, [fan_centre, feature_vertex], crease, &removed, &dead);
     }
     welded
+}
+
+/// Where two centres kept [`INSET`] off either side of one grid plane (the grid's origin and
+/// spacing in `grid`) meet in it: their midpoint, put on the plane; `None` unless they differ along
+/// one axis alone (to a millionth of the spacing), by at most 2.25 insets there, across a plane.
+fn across_one_grid_plane(p1: Vec3, p2: Vec3, (origin, spacing): (Vec3, Vec3)) -> Option<Vec3> {
+    let d = (p2 - p1).abs();
+    let axis = d.max_position();
+    let same = (0..3).all(|a| a == axis || d[a] <= 1e-6 * spacing[a]);
+    if !same || d[axis] > 2.25 * INSET * spacing[axis] {
+        return None;
+    }
+    let mut mid = (p1 + p2) * 0.5;
+    let plane = origin[axis] + ((mid[axis] - origin[axis]) / spacing[axis]).round() * spacing[axis];
+    let (lo, hi) = (p1[axis].min(p2[axis]), p1[axis].max(p2[axis]));
+    if !(lo < plane && plane < hi) {
+        return None;
+    }
+    mid[axis] = plane;
+    Some(mid)
 }
 
 /// Per vertex, the triangles that use it.
@@ -347,6 +361,9 @@ mod tests {
         );
     }
 
+    /// A grid of unit cells from the origin: z = 0 is one of its planes.
+    const UNIT_GRID: (Vec3, Vec3) = (Vec3::ZERO, Vec3::ONE);
+
     /// Two fans either side of the plane z = 0, centres 0.02 apart, sharing the edge (a, b) in
     /// it: the fan above over (a, b, p), the one below over (b, a, r).
     fn back_to_back_fans() -> Mesh {
@@ -370,7 +387,7 @@ mod tests {
         let (mut centre, mut feature) = (vec![false, false, false, false, true, true], vec![false; 6]);
         feature[5] = true;
         let mut crease = vec![Vec3::ZERO; 6];
-        assert_eq!(weld_facing_centres(&mut mesh, &mut centre, &mut feature, &mut crease, 1.0), 1);
+        assert_eq!(weld_facing_centres(&mut mesh, &mut centre, &mut feature, &mut crease, UNIT_GRID), 1);
         assert_eq!((mesh.vertex_count(), mesh.triangle_count()), (5, 4));
         assert_eq!(centre, [false, false, false, false, true]);
         assert_eq!(feature, [false, false, false, false, true], "the weld keeps either's feature flag");
@@ -382,14 +399,21 @@ mod tests {
     }
 
     #[test]
-    fn fan_centres_too_far_apart_or_sharing_more_than_the_edge_stay() {
+    fn fan_centres_too_far_apart_aside_or_sharing_more_than_the_edge_stay() {
         let mut far = back_to_back_fans();
         far.positions[5].z = -0.2;
         let (mut centre, mut feature) = (vec![false, false, false, false, true, true], vec![false; 6]);
         assert_eq!(
-            weld_facing_centres(&mut far, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 6], 1.0),
+            weld_facing_centres(&mut far, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 6], UNIT_GRID),
             0
         );
+        // Near, but not one point's two insets: they differ across the face too.
+        let mut aside = back_to_back_fans();
+        aside.positions[5].x += 0.01;
+        let (mut centre, mut feature) = (vec![false, false, false, false, true, true], vec![false; 6]);
+        let welded =
+            weld_facing_centres(&mut aside, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 6], UNIT_GRID);
+        assert_eq!(welded, 0);
         // Both fans over the same triangle (a, b, p): welding would leave two triangles on one
         // edge pair, a closed pillow flattened.
         let mut pillow = fixtures::mesh(
@@ -398,7 +422,7 @@ mod tests {
         );
         let (mut centre, mut feature) = (vec![false, false, false, true, true], vec![false; 5]);
         let welded =
-            weld_facing_centres(&mut pillow, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 5], 1.0);
+            weld_facing_centres(&mut pillow, &mut centre, &mut feature, &mut vec![Vec3::ZERO; 5], UNIT_GRID);
         assert_eq!((welded, pillow.triangle_count()), (0, 6));
     }
 }

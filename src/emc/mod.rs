@@ -248,7 +248,7 @@ pub fn mesh_with_sampler(
         &mut centres.any,
         &mut out.feature_vertex,
         &mut centres.crease,
-        grid.cell_size(),
+        (grid.origin, grid.spacing),
     );
     out.feature_edges =
         lines::feature_edges(&out.mesh, &centres.any, &out.feature_vertex, &centres.crease, grid.cell_size());

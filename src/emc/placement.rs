@@ -30,7 +30,7 @@ use crate::mesh::analysis::tri_tri::folded_across_edge;
 use glam::Vec3;
 
 /// How far (in cells) points placed in the cell stay off its faces.
-const INSET: f32 = 1e-2;
+pub(crate) const INSET: f32 = 1e-2;
 /// Samples along a feature line when searching it for a valid fan.
 const LINE_SAMPLES: usize = 32;
 /// How far (in cells) a fan centre may leave its cell, where the planes meet just outside it.
