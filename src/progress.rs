@@ -145,4 +145,27 @@ mod tests {
             Ok(surface_error(&out.mesh, field.as_ref()))
         );
     }
+
+    /// The crossing check of a large mesh checks in every few thousand box pairs: the page runs it
+    /// after every mesh, and the next request stops it there instead of waiting for it. Without a
+    /// hook it finds what `self_intersecting_pairs` does.
+    #[test]
+    fn the_crossing_check_stops_part_way() {
+        use crate::mesh::analysis::{self_intersecting_pairs, self_intersecting_pairs_cancellable};
+        use crate::pipeline::{mesh_scene, Request};
+        let out = mesh_scene("torus", &Request { res: 64, ..Request::default() }).unwrap();
+        let calls = Rc::new(RefCell::new(0));
+        let count = calls.clone();
+        let stopped = with_hook(
+            move |phase, _| {
+                assert_eq!(phase, "analysis");
+                *count.borrow_mut() += 1;
+                *count.borrow() == 2
+            },
+            || self_intersecting_pairs_cancellable(&out.mesh),
+        );
+        assert_eq!(stopped, Err(Error::Cancelled));
+        assert_eq!(*calls.borrow(), 2, "stopped at the second checkpoint, not run to the end");
+        assert_eq!(self_intersecting_pairs_cancellable(&out.mesh), Ok(self_intersecting_pairs(&out.mesh)));
+    }
 }

@@ -137,7 +137,8 @@ impl Stats {
 }
 
 /// Analyses `mesh` against `field` (its true surface) and bundles the numbers with the timings;
-/// fails only with [`Error::Cancelled`], where a progress hook stops the surface measurement.
+/// fails only with [`Error::Cancelled`], where a progress hook stops the crossing check or the
+/// surface measurement.
 pub fn compute(
     method: &str,
     res: usize,
@@ -150,7 +151,10 @@ pub fn compute(
     let topo = analysis::topology(mesh);
     let angles = analysis::angle_stats(mesh);
     let (aspect_mean, aspect_max) = analysis::aspect_ratios(mesh);
-    let intersections = options.self_intersections.then(|| analysis::self_intersections(mesh));
+    let intersections = options
+        .self_intersections
+        .then(|| analysis::self_intersecting_pairs_cancellable(mesh).map(|pairs| pairs.len()))
+        .transpose()?;
     let error = (options.surface_error && mesh.triangle_count() > 0)
         .then(|| analysis::surface_error_cancellable(mesh, field))
         .transpose()?;

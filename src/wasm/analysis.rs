@@ -64,11 +64,14 @@ pub fn analyze_mesh(
         return Err(invalid(format!("vertex {v} is not finite: {:?}", mesh.positions[v].to_array())));
     }
     let (program, check_intersections) = parse(options)?;
-    // Crossings first: they have no checkpoints inside, so a cancel that comes while they run
-    // waits for them; the surface error after them checks for a cancel every few thousand faces.
+    // Both checks look for a cancel every few thousand box pairs or faces: the page runs them
+    // after every mesh, and the next request must not wait for them.
     let (pairs, error) = with_progress(|| -> Result<_, Error> {
         crate::progress::checkpoint("analysis", 0.0)?;
-        let pairs = check_intersections.then(|| analysis::self_intersecting_pairs(&mesh));
+        let pairs = match check_intersections {
+            true => Some(analysis::self_intersecting_pairs_cancellable(&mesh)?),
+            false => None,
+        };
         let error = match &program {
             Some(program) if mesh.triangle_count() > 0 => {
                 let (lo, hi) = mesh

@@ -54,6 +54,9 @@ pub struct Bvh {
     items: Vec<u32>,
 }
 
+/// Node pairs [`Bvh::overlapping_pairs_until`] walks between two calls of its `tick`.
+pub const PAIRS_PER_TICK: usize = 4096;
+
 impl Bvh {
     pub fn build(boxes: &[Aabb]) -> Bvh {
         let mut bvh = Bvh {
@@ -104,12 +107,32 @@ impl Bvh {
     }
 
     /// Calls `visit(i, j)` once for every unordered pair `i != j` of overlapping boxes.
-    pub fn overlapping_pairs(&self, boxes: &[Aabb], mut visit: impl FnMut(u32, u32)) {
+    pub fn overlapping_pairs(&self, boxes: &[Aabb], visit: impl FnMut(u32, u32)) {
+        match self.overlapping_pairs_until(boxes, visit, || Ok::<(), std::convert::Infallible>(())) {
+            Ok(()) => {}
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Bvh::overlapping_pairs`] that calls `tick` every [`PAIRS_PER_TICK`] node pairs and stops
+    /// at its first error: the walk over a large mesh's boxes is long, and a page that abandons
+    /// the request must be able to stop it.
+    pub fn overlapping_pairs_until<E>(
+        &self,
+        boxes: &[Aabb],
+        mut visit: impl FnMut(u32, u32),
+        mut tick: impl FnMut() -> Result<(), E>,
+    ) -> Result<(), E> {
         if self.nodes.is_empty() {
-            return;
+            return Ok(());
         }
         let mut stack = vec![(0u32, 0u32)];
+        let mut popped = 0usize;
         while let Some((a, b)) = stack.pop() {
+            popped += 1;
+            if popped % PAIRS_PER_TICK == 0 {
+                tick()?;
+            }
             let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
             if a == b {
                 if na.count > 0 {
@@ -152,6 +175,7 @@ impl Bvh {
                 }
             }
         }
+        Ok(())
     }
 
     /// Depth-first walk for queries against one object (a ray, a point): `key(state, bounds)` is

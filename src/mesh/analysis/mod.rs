@@ -28,7 +28,9 @@ pub(crate) mod fixtures;
 
 pub use digital::digital_euler;
 pub use quality::{angle_stats, aspect_ratios, signed_volume, surface_area, AngleStats};
-pub use self_intersect::{folded_pairs, self_intersecting_pairs, self_intersections};
+pub use self_intersect::{
+    folded_pairs, self_intersecting_pairs, self_intersecting_pairs_cancellable, self_intersections,
+};
 pub use surface_error::{surface_error, surface_error_cancellable, SurfaceError};
 pub use topology::{degenerate_triangles, topology, Topology};
 

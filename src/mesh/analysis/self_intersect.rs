@@ -30,6 +30,20 @@ pub fn self_intersections(mesh: &Mesh) -> usize {
 
 /// The intersecting pairs `[i, j]` (triangle indices, `i < j`), sorted: for highlighting them.
 pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
+    match pairs_until(mesh, || Ok::<(), std::convert::Infallible>(())) {
+        Ok(pairs) => pairs,
+        Err(never) => match never {},
+    }
+}
+
+/// [`self_intersecting_pairs`] with a [`checkpoint`](crate::progress::checkpoint) every few
+/// thousand box pairs: on the page it runs after every mesh, and a newer request must be able to
+/// stop it within milliseconds, not wait for it.
+pub fn self_intersecting_pairs_cancellable(mesh: &Mesh) -> Result<Vec<[u32; 2]>, crate::Error> {
+    pairs_until(mesh, || crate::progress::checkpoint("analysis", 0.0))
+}
+
+fn pairs_until<E>(mesh: &Mesh, tick: impl FnMut() -> Result<(), E>) -> Result<Vec<[u32; 2]>, E> {
     let ids: Vec<u32> = (0..mesh.triangles.len() as u32)
         .filter(|&t| {
             let [a, b, c] = mesh.triangles[t as usize];
@@ -39,14 +53,18 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
     let boxes: Vec<Aabb> = ids.iter().map(|&t| Aabb::of_points(&mesh.corners(t as usize))).collect();
     let bvh = Bvh::build(&boxes);
     let mut pairs = Vec::new();
-    bvh.overlapping_pairs(&boxes, |i, j| {
-        let (s, t) = (ids[i as usize], ids[j as usize]);
-        if triangle_pair_intersects(mesh, s as usize, t as usize) {
-            pairs.push([s.min(t), s.max(t)]);
-        }
-    });
+    bvh.overlapping_pairs_until(
+        &boxes,
+        |i, j| {
+            let (s, t) = (ids[i as usize], ids[j as usize]);
+            if triangle_pair_intersects(mesh, s as usize, t as usize) {
+                pairs.push([s.min(t), s.max(t)]);
+            }
+        },
+        tick,
+    )?;
     pairs.sort_unstable();
-    pairs
+    Ok(pairs)
 }
 
 /// Whether triangles `s` and `t` of `mesh` intersect, by the rules of this module.

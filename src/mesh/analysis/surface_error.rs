@@ -75,7 +75,7 @@ pub fn surface_error_cancellable(mesh: &Mesh, field: &dyn Field) -> Result<Surfa
 }
 
 /// Faces measured between two calls of the `tick` of [`measure`].
-const FACES_PER_TICK: usize = 4096;
+const FACES_PER_TICK: usize = 1024;
 
 fn measure<E>(
     mesh: &Mesh,
