@@ -67,7 +67,7 @@ pub fn merge_flat_crossings(
 /// Welds pairs of fan centres that stand for one feature point lying in the cell face between
 /// them, and drops the two triangles they fold back to back. Where a feature point (a cone's apex,
 /// a corner) lies in a grid plane, both cells beside it place their centre on it, each kept
-/// [`INSET`] of a cell inside its own cell, and both fan the edge their polygons share in that
+/// a hundredth of a cell inside its own cell, and both fan the edge their polygons share in that
 /// face: two triangles lying in the face, one on top of the other, turned 90° from a surface that
 /// crosses the face (a fin on the cube with cut-outs, whose countersink's apex lies in a grid
 /// plane at 32, 48, 64 and 128 cells). One vertex on the face serves both fans, and the two
