@@ -30,11 +30,14 @@ let ready = null;
  */
 async function load(threads) {
   // `ISOFORGE_WASM` is set only by the Node wrapper (mesher-worker-node.js); browsers fetch the file.
-  if (threads !== 1 && self.crossOriginIsolated && !globalThis.ISOFORGE_WASM) {
+  // A bundler renames this script (Vite: assets/mesher-worker-<hash>.js) and puts no threads/
+  // beside it, so there the threaded build is not even asked for: one failed request less.
+  const bundled = !new URL(import.meta.url).pathname.endsWith('/mesher-worker.js');
+  if (threads !== 1 && self.crossOriginIsolated && !globalThis.ISOFORGE_WASM && !bundled) {
     try {
-      // Not a literal: bundlers leave it alone (their output has no threads/ beside it, and the
-      // import then fails over to the plain build).
-      const url = new URL('./threads/isoforge.js', import.meta.url).href;
+      // Not a literal: a bundler that emits `new URL('<literal>', import.meta.url)` as an asset
+      // would copy the threaded glue without the worker helpers it imports.
+      const url = new URL(['.', 'threads', 'isoforge.js'].join('/'), import.meta.url).href;
       const threaded = await import(/* @vite-ignore */ url);
       await threaded.default();
       await threaded.startThreads(threads || Math.min(MAX_THREADS, navigator.hardwareConcurrency || 1));
