@@ -31,9 +31,10 @@ let ready = null;
 async function load(threads) {
   // `ISOFORGE_WASM` is set only by the Node wrapper (mesher-worker-node.js); browsers fetch the file.
   // A bundler renames this script (Vite: assets/mesher-worker-<hash>.js) and puts no threads/
-  // beside it, so there the threaded build is not even asked for: one failed request less.
+  // beside it, so there the threaded build is asked for only when a thread count was given (the
+  // app copied threads/ next to the emitted script): otherwise one failed request less.
   const bundled = !new URL(import.meta.url).pathname.endsWith('/mesher-worker.js');
-  if (threads !== 1 && self.crossOriginIsolated && !globalThis.ISOFORGE_WASM && !bundled) {
+  if (threads !== 1 && self.crossOriginIsolated && !globalThis.ISOFORGE_WASM && (!bundled || threads > 1)) {
     try {
       // Not a literal: a bundler that emits `new URL('<literal>', import.meta.url)` as an asset
       // would copy the threaded glue without the worker helpers it imports.
