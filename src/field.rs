@@ -197,6 +197,24 @@ pub fn gradients_or_differences(
     );
 }
 
+/// Values and [`gradient_or_differences`] at many points, in one [`Field::values_and_gradients`]
+/// batch (one pass of a compiled program) and central differences where the field has none.
+pub fn values_and_gradients_or_differences(
+    field: &dyn Field,
+    points: &[Vec3],
+    h: f32,
+) -> (Vec<f32>, Vec<Vec3>) {
+    let mut values = vec![0.0; points.len()];
+    let mut exact = vec![None; points.len()];
+    field.values_and_gradients(points, &mut values, &mut exact);
+    let gradients = points
+        .iter()
+        .zip(&exact)
+        .map(|(&p, &g)| g.unwrap_or_else(|| finite_difference_gradient(field, p, h)))
+        .collect();
+    (values, gradients)
+}
+
 /// Central-difference gradient with step `h`: the fallback for fields that know no gradient.
 pub fn finite_difference_gradient(field: &dyn Field, p: Vec3, h: f32) -> Vec3 {
     let dx = Vec3::new(h, 0.0, 0.0);

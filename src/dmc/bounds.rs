@@ -70,22 +70,6 @@ impl Clipped<'_> {
     }
 }
 
-impl Clipped<'_> {
-    /// Values and gradients (central differences of step `h` where the field has none) at many
-    /// points, in one of the field's batches.
-    pub fn values_and_gradients_or_differences(&self, points: &[Vec3], h: f32) -> (Vec<f32>, Vec<Vec3>) {
-        let mut values = vec![0.0; points.len()];
-        let mut exact = vec![None; points.len()];
-        Field::values_and_gradients(self, points, &mut values, &mut exact);
-        let gradients = points
-            .iter()
-            .zip(&exact)
-            .map(|(&p, &g)| g.unwrap_or_else(|| crate::field::finite_difference_gradient(self, p, h)))
-            .collect();
-        (values, gradients)
-    }
-}
-
 fn largest_axis(v: Vec3) -> usize {
     if v.x >= v.y && v.x >= v.z {
         0

@@ -103,7 +103,8 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
         }
     }
     stats.samples = points.len();
-    let (values, gradients) = field.values_and_gradients_or_differences(&points, spacing * 1e-2);
+    let (values, gradients) =
+        crate::field::values_and_gradients_or_differences(field, &points, spacing * 1e-2);
 
     let per_cell = samples_per_cell.pow(3);
     let mut vertices = Vec::with_capacity(crust.len());

@@ -14,7 +14,7 @@ use super::contour::{batch_roots, Segment};
 use super::dual::VertexKey;
 use super::safety::EdgeTriangle;
 use super::tree::{Kind, Octree};
-use crate::field::{finite_difference_gradient, Field};
+use crate::field::{values_and_gradients_or_differences, Field};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -74,15 +74,8 @@ impl<'a> Fidelity<'a> {
             }
             samples.push(ids);
         }
-        let mut values = vec![0.0; self.points.len()];
-        let mut exact = vec![None; self.points.len()];
-        self.field.values_and_gradients(&self.points, &mut values, &mut exact);
-        let gradients: Vec<Vec3> = self
-            .points
-            .iter()
-            .zip(&exact)
-            .map(|(&p, &g)| g.unwrap_or_else(|| finite_difference_gradient(self.field, p, tree.h * 1e-2)))
-            .collect();
+        let (values, gradients) =
+            values_and_gradients_or_differences(self.field, &self.points, tree.h * 1e-2);
         let close: Vec<bool> = values
             .iter()
             .zip(&gradients)

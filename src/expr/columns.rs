@@ -149,8 +149,8 @@ impl DualColumn {
 }
 
 /// Values and gradients at many points (see [`super::eval::eval_gradient`] for the conventions
-/// at kinks), each pair passed through `wrap` (callers that want `Option`s need no second buffer); only the
-/// first `min(points.len(), out.len())` are written.
+/// at kinks), each pair passed through `wrap` (callers that want `Option`s need no second
+/// buffer); only the first `min(points.len(), out.len())` are written.
 pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wrap: impl Fn(f32, Vec3) -> O) {
     if points.len().min(out.len()) < SMALL_GRADIENT_BATCH {
         for (o, &p) in out.iter_mut().zip(points) {
@@ -171,12 +171,10 @@ pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wra
         },
         run_dual_column,
         |col, out| {
-            out.iter_mut().enumerate().for_each(|(l, o)| {
-                *o = {
-                    let lane = col.lane(l);
-                    wrap(lane.v, lane.d.into())
-                }
-            })
+            for (l, o) in out.iter_mut().enumerate() {
+                let lane = col.lane(l);
+                *o = wrap(lane.v, lane.d.into());
+            }
         },
     );
 }

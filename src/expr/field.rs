@@ -29,13 +29,19 @@ impl Field for Program {
     fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
         let mut both = vec![(0.0, Vec3::ZERO); points.len().min(values.len()).min(gradients.len())];
         self.eval_value_grad_many(points, &mut both);
-        for ((v, g), (bv, bg)) in values.iter_mut().zip(gradients.iter_mut()).zip(both) {
-            (*v, *g) = (bv, Some(bg));
-        }
+        unzip_into(&both, values, gradients);
     }
 
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
         Some(self.eval_interval(lo, hi))
+    }
+}
+
+/// Writes `(value, gradient)` pairs, as the one-pass evaluators return them, into the two slices
+/// of [`Field::values_and_gradients`].
+pub(super) fn unzip_into(both: &[(f32, Vec3)], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
+    for ((v, g), &(bv, bg)) in values.iter_mut().zip(gradients.iter_mut()).zip(both) {
+        (*v, *g) = (bv, Some(bg));
     }
 }
 

@@ -354,9 +354,7 @@ impl Field for RegionalProgram<'_> {
     fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
         let mut both = vec![(0.0, Vec3::ZERO); points.len().min(values.len()).min(gradients.len())];
         self.batched(points, &mut both, |program, p, o| program.eval_value_grad_many(p, o));
-        for ((v, g), (bv, bg)) in values.iter_mut().zip(gradients.iter_mut()).zip(both) {
-            (*v, *g) = (bv, Some(bg));
-        }
+        super::field::unzip_into(&both, values, gradients);
     }
 
     fn interval(&self, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {

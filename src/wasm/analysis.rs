@@ -68,10 +68,8 @@ pub fn analyze_mesh(
     // after every mesh, and the next request must not wait for them.
     let (pairs, error) = with_progress(|| -> Result<_, Error> {
         crate::progress::checkpoint("analysis", 0.0)?;
-        let pairs = match check_intersections {
-            true => Some(analysis::self_intersecting_pairs_cancellable(&mesh)?),
-            false => None,
-        };
+        let pairs =
+            check_intersections.then(|| analysis::self_intersecting_pairs_cancellable(&mesh)).transpose()?;
         let error = match &program {
             Some(program) if mesh.triangle_count() > 0 => {
                 let (lo, hi) = mesh
