@@ -223,7 +223,11 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         },
         max_cells: args.max_cells,
         bounds: args.bounds.as_ref().map(|b| (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]))),
-        analysis: AnalysisOptions { self_intersections: !args.no_intersections, surface_error: true },
+        // Without --stats nobody reads the error measures, and they can cost more than the meshing.
+        analysis: AnalysisOptions {
+            self_intersections: args.stats && !args.no_intersections,
+            surface_error: args.stats,
+        },
         theta_sharp: args.theta_sharp,
         phi_corner: args.phi_corner,
         directed: !args.no_directed,
