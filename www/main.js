@@ -134,6 +134,8 @@ async function run(event) {
   remember();
   setStatus('busy', 'meshing…');
   await Promise.all(panes.map((p) => p.mesh(editor.text, options(p.method, bounds))));
+  // After every picture is up, not as each arrives (Pane.measureShown says why).
+  for (const p of panes) p.measureShown();
   if (panes.every((p) => p.root.dataset.state !== 'busy')) setStatus(note ? 'error' : 'done', note);
 }
 

@@ -120,16 +120,23 @@ export class Pane {
       clearInterval(tick);
       if (this.call === call) busy.hidden = true;
     }
-    if (result && this.call === call) await this.measure(text, result, call);
+    if (result && this.call === call) {
+      this.root.dataset.measured = 'pending';
+      this.unmeasured = { text, result, call };
+    }
   }
 
   /**
    * Measures the mesh shown (its distance and normal error against the program, and the
-   * triangles that cross) after it is on screen: the numbers cost as much as meshing, the picture
-   * should not wait for them. `data-measured` is "pending" until they are in, then "yes".
+   * triangles that cross). The page calls it once every pane shows its mesh: the numbers cost as
+   * much as meshing, and on a machine with few cores one pane's numbers would hold up the other
+   * pane's picture. `data-measured` is "pending" from the mesh's arrival until they are in, then "yes".
    */
-  async measure(text, result, call) {
-    this.root.dataset.measured = 'pending';
+  async measureShown() {
+    const job = this.unmeasured;
+    this.unmeasured = null;
+    if (!job || this.call !== job.call) return;
+    const { text, result, call } = job;
     try {
       const measured = await this.mesher.analyzeMesh(result, { expr: text, checkIntersections: true });
       if (this.call !== call) return;
