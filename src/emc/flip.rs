@@ -43,28 +43,40 @@ pub fn flip_toward_features(
             directed.insert((tri[k], tri[(k + 1) % 3]), t as u32);
         }
     }
-    let mut candidates: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
-    candidates.sort_unstable();
+    let mut edges: Vec<(u32, u32)> = directed.keys().copied().filter(|&(a, b)| a < b).collect();
+    edges.sort_unstable();
+    // Each candidate edge (a, b) with its two triangles and their far corners (c, d): an edge
+    // between two crossings, between two fan centres, one of them on its feature. Only edges
+    // between two crossing vertices are flipped: turning an edge that already ends at a feature
+    // point would join that point's two neighbours on the feature line past it. A flip only makes
+    // triangles with a fan centre and no edge between two crossings, so it never changes another
+    // candidate's triangles: these are the candidates throughout, and their quads hold every
+    // triangle a flip can make.
+    let candidates: Vec<Candidate> = edges
+        .into_iter()
+        .filter_map(|(a, b)| {
+            let (&t1, &t2) = (directed.get(&(a, b))?, directed.get(&(b, a))?);
+            let c = opposite(mesh.triangles[t1 as usize], a, b);
+            let d = opposite(mesh.triangles[t2 as usize], b, a);
+            let joins_centres = c != d && is_feature[c as usize] && is_feature[d as usize];
+            let flippable = joins_centres
+                && (on_feature[c as usize] || on_feature[d as usize])
+                && !is_feature[a as usize]
+                && !is_feature[b as usize];
+            flippable.then_some(Candidate { a, b, t1, t2, c, d })
+        })
+        .collect();
+    let region: Vec<(Vec3, Vec3)> = candidates
+        .iter()
+        .map(|q| {
+            let q = [q.a, q.b, q.c, q.d].map(|v| mesh.positions[v as usize]);
+            (q.iter().fold(q[0], |m, &p| m.min(p)), q.iter().fold(q[0], |m, &p| m.max(p)))
+        })
+        .collect();
     // Built on the first flip that gets as far as the crossing test.
     let mut nearby: Option<NearbyTriangles> = None;
     let mut flips = 0;
-    for (a, b) in candidates {
-        let (Some(&t1), Some(&t2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
-            continue;
-        };
-        let c = opposite(mesh.triangles[t1 as usize], a, b);
-        let d = opposite(mesh.triangles[t2 as usize], b, a);
-        if c == d || !is_feature[c as usize] || !is_feature[d as usize] {
-            continue;
-        }
-        if !on_feature[c as usize] && !on_feature[d as usize] {
-            continue;
-        }
-        if is_feature[a as usize] || is_feature[b as usize] {
-            // Only edges between two crossing vertices are flipped: turning an edge that already ends
-            // at a feature point would join that point's two neighbours on the feature line past it.
-            continue;
-        }
+    for Candidate { a, b, t1, t2, c, d } in candidates {
         if directed.contains_key(&(c, d)) || directed.contains_key(&(d, c)) {
             continue;
         }
@@ -100,7 +112,7 @@ pub fn flip_toward_features(
             continue;
         }
         let (tri1, tri2) = ([c, a, d], [d, b, c]);
-        let buckets = nearby.get_or_insert_with(|| NearbyTriangles::new(mesh, spacing));
+        let buckets = nearby.get_or_insert_with(|| NearbyTriangles::around(mesh, spacing, &region));
         if [tri1, tri2].iter().any(|&t| buckets.crosses(mesh, t, &t.map(p), &[t1, t2])) {
             continue;
         }
@@ -118,6 +130,17 @@ pub fn flip_toward_features(
         flips += 1;
     }
     flips
+}
+
+/// An edge (a, b) between two crossings, its triangles t1 (holding a → b) and t2, and their
+/// far corners c and d, both fan centres.
+struct Candidate {
+    a: u32,
+    b: u32,
+    t1: u32,
+    t2: u32,
+    c: u32,
+    d: u32,
 }
 
 fn opposite(tri: [u32; 3], a: u32, b: u32) -> u32 {

@@ -37,7 +37,7 @@ pub fn merge_flat_crossings(
     h: f32,
 ) -> usize {
     let n = mesh.positions.len();
-    let mut incident = incident_triangles(mesh);
+    let mut incident = incident_near_centres(mesh, fan_centre);
     let mut dead = vec![false; mesh.triangles.len()];
     let mut removed = vec![false; n];
     let tolerance = FLAT_TOLERANCE * h;
@@ -85,11 +85,12 @@ pub fn weld_facing_centres(
     crease: &mut Vec<Vec3>,
     grid: (Vec3, Vec3),
 ) -> usize {
-    let mut incident = incident_triangles(mesh);
+    let mut incident = incident_near_centres(mesh, fan_centre);
     // The edges between crossings, with the triangle on each side: sorted, an edge's two
     // triangles are neighbours in the list.
     let mut edges: Vec<((u32, u32), u32)> = Vec::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
+    let fanned = |tri: &&[u32; 3]| tri.iter().any(|&v| fan_centre[v as usize]);
+    for (t, tri) in mesh.triangles.iter().enumerate().filter(|(_, tri)| fanned(tri)) {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             if !fan_centre[a as usize] && !fan_centre[b as usize] {
@@ -160,10 +161,18 @@ fn across_one_grid_plane(p1: Vec3, p2: Vec3, (origin, spacing): (Vec3, Vec3)) ->
 }
 
 /// Per vertex, the triangles that use it.
-fn incident_triangles(mesh: &Mesh) -> Vec<Vec<u32>> {
+/// The triangles at each fan centre and at each vertex of a fan centre's one-ring; other
+/// vertices' lists are left empty. Both passes here only look at fan centres and at crossings
+/// next to one, and building lists for every vertex (over 200 000 at 256 cells) cost more than
+/// the passes.
+fn incident_near_centres(mesh: &Mesh, fan_centre: &[bool]) -> Vec<Vec<u32>> {
+    let mut near = vec![false; mesh.positions.len()];
+    for tri in mesh.triangles.iter().filter(|tri| tri.iter().any(|&v| fan_centre[v as usize])) {
+        tri.iter().for_each(|&v| near[v as usize] = true);
+    }
     let mut incident: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
     for (t, tri) in mesh.triangles.iter().enumerate() {
-        for &v in tri {
+        for &v in tri.iter().filter(|&&v| near[v as usize]) {
             incident[v as usize].push(t as u32);
         }
     }

@@ -47,7 +47,24 @@ pub fn pull_back_crossing_fans(
             }
         }
     }
-    let mut buckets = NearbyTriangles::new(mesh, spacing);
+    // Questions are about these fans' triangles, each corner where it is or, for a centre that
+    // may move, where it would go.
+    let moves: HashMap<u32, Vec3> = fans.iter().map(|f| (f.vertex, f.inside.position)).collect();
+    let region: Vec<(Vec3, Vec3)> = incident
+        .values()
+        .flatten()
+        .map(|&t| {
+            let corners = mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
+            let moved = mesh.triangles[t as usize]
+                .map(|v| moves.get(&v).copied().unwrap_or(mesh.positions[v as usize]));
+            let (lo, hi) = corners
+                .iter()
+                .chain(&moved)
+                .fold((corners[0], corners[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            (lo, hi)
+        })
+        .collect();
+    let mut buckets = NearbyTriangles::around(mesh, spacing, &region);
     let mut moved = Vec::new();
     fans.retain(|fan| {
         let own = &incident[&fan.vertex];

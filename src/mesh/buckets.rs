@@ -41,12 +41,24 @@ const KEY_RANGE: i64 = 1 << 20;
 impl TriangleBuckets {
     /// Buckets of side `cell` over the triangles with these bounding boxes, ids 0, 1, 2, ….
     pub fn build(cell: f64, boxes: impl Iterator<Item = (DVec3, DVec3)>) -> TriangleBuckets {
-        let boxes: Vec<(DVec3, DVec3)> = boxes.collect();
+        TriangleBuckets::build_some(cell, boxes.map(Some))
+    }
+
+    /// Buckets over the triangles given a box, ids 0, 1, 2, … (`None`: not recorded, until an
+    /// [`insert`](Self::insert)).
+    pub fn build_some(cell: f64, boxes: impl Iterator<Item = Option<(DVec3, DVec3)>>) -> TriangleBuckets {
+        let mut present = Vec::new();
+        let boxes: Vec<(DVec3, DVec3)> = boxes
+            .map(|b| {
+                present.push(b.is_some());
+                b.unwrap_or((DVec3::ZERO, DVec3::ZERO))
+            })
+            .collect();
         let mut out = TriangleBuckets {
             cell: if cell > 0.0 && cell.is_finite() { cell } else { 1.0 },
             built: Vec::with_capacity(boxes.len()),
             added: FxHashMap::default(),
-            present: vec![true; boxes.len()],
+            present,
             in_added: vec![false; boxes.len()],
             loose_extent: DVec3::ZERO,
             seen: vec![0; boxes.len()],
@@ -54,10 +66,12 @@ impl TriangleBuckets {
             stamp: 0,
         };
         let mut built = std::mem::take(&mut out.built);
-        for (id, &(lo, hi)) in out.boxes.iter().enumerate() {
+        let mut extent = DVec3::ZERO;
+        for (id, &(lo, hi)) in out.boxes.iter().enumerate().filter(|&(id, _)| out.present[id]) {
             out.for_cubes(lo, hi, |k| built.push((k, id as u32)));
+            extent = out.widen(extent, lo, hi);
         }
-        out.loose_extent = out.boxes.iter().fold(DVec3::ZERO, |e, &(lo, hi)| out.widen(e, lo, hi));
+        out.loose_extent = extent;
         built.sort_unstable();
         out.built = built;
         out
@@ -116,6 +130,11 @@ impl TriangleBuckets {
         for k in keys {
             self.added.entry(k).or_default().push(id);
         }
+    }
+
+    /// How many triangles are recorded now.
+    pub fn recorded(&self) -> usize {
+        self.present.iter().filter(|&&p| p).count()
     }
 
     /// Forgets triangle `id`.
