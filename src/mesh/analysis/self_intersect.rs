@@ -98,7 +98,7 @@ pub fn indexed_pair_intersects(s: ([u32; 3], [DVec3; 3]), t: ([u32; 3], [DVec3; 
 /// Pairs `[i, j]` (`i < j`, sorted) of triangles sharing an edge that fold onto each other (see
 /// [`folded_across_edge`]). Collapsed triangles are skipped.
 pub fn folded_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
-    let mut by_edge: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let mut by_edge: rustc_hash::FxHashMap<(u32, u32), u32> = rustc_hash::FxHashMap::default();
     let mut pairs = Vec::new();
     for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         if a == b || b == c || a == c {
