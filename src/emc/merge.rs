@@ -160,7 +160,6 @@ fn across_one_grid_plane(p1: Vec3, p2: Vec3, (origin, spacing): (Vec3, Vec3)) ->
     Some(mid)
 }
 
-/// Per vertex, the triangles that use it.
 /// The triangles at each fan centre and at each vertex of a fan centre's one-ring; other
 /// vertices' lists are left empty. Both passes here only look at fan centres and at crossings
 /// next to one, and building lists for every vertex (over 200 000 at 256 cells) cost more than

@@ -207,6 +207,60 @@ mod tests {
         assert_eq!(around.buckets_recorded(), 1, "the far triangle is left out");
     }
 
+    /// Random soups of small triangles (the sizes of EMC's, up to two cells), random regions of
+    /// a few boxes, random questions inside them: the region's buckets answer as the whole
+    /// mesh's do, before and after triangles move within the region.
+    #[test]
+    fn around_a_region_answers_as_the_whole_mesh_does() {
+        for seed in 0..40u64 {
+            let mut rng = crate::expr::testutil::Rng::new(9100 + seed);
+            let cell = rng.range(0.05, 0.3);
+            let mut mesh = Mesh { positions: Vec::new(), normals: Vec::new(), triangles: Vec::new() };
+            for t in 0..300u32 {
+                let a = rng.vec3(-1.0, 1.0);
+                for _ in 0..3 {
+                    mesh.positions.push(a + rng.vec3(-cell, cell));
+                }
+                mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
+            }
+            let boxes: Vec<(Vec3, Vec3)> = (0..1 + rng.below(4))
+                .map(|_| {
+                    let lo = rng.vec3(-1.0, 0.8);
+                    (lo, lo + rng.vec3(0.0, 3.0 * cell))
+                })
+                .collect();
+            let spacing = Vec3::splat(cell);
+            let mut around = NearbyTriangles::around(&mesh, spacing, &boxes);
+            let mut all = NearbyTriangles::new(&mesh, spacing);
+            let sorted = |mut v: Vec<u32>| {
+                v.sort_unstable();
+                v
+            };
+            for round in 0..2 {
+                for _ in 0..50 {
+                    let (lo, hi) = boxes[rng.below(boxes.len())];
+                    let question = [0; 3].map(|_: u8| lo + (hi - lo) * rng.vec3(0.0, 1.0));
+                    assert_eq!(
+                        sorted(around.near(&question)),
+                        sorted(all.near(&question)),
+                        "seed {seed}, round {round}"
+                    );
+                }
+                // Move a few triangles that lie in a region box to other places in it.
+                for _ in 0..10 {
+                    let (lo, hi) = boxes[rng.below(boxes.len())];
+                    let t = rng.below(mesh.triangles.len());
+                    let corners = [0; 3].map(|_: u8| lo + (hi - lo) * rng.vec3(0.0, 1.0));
+                    for (k, &p) in corners.iter().enumerate() {
+                        mesh.positions[3 * t + k] = p;
+                    }
+                    around.insert(t as u32, &corners);
+                    all.insert(t as u32, &corners);
+                }
+            }
+        }
+    }
+
     #[test]
     #[cfg(debug_assertions)]
     #[should_panic(expected = "asked outside the region")]
