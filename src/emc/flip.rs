@@ -9,6 +9,7 @@
 //! [`super::nearby`]); each accepted flip then leaves every pair it did not touch as it was.
 
 use super::nearby::NearbyTriangles;
+use crate::mesh::analysis::bvh::Aabb;
 use crate::mesh::analysis::tri_tri::folded_across_edge;
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -66,12 +67,9 @@ pub fn flip_toward_features(
             flippable.then_some(Candidate { a, b, t1, t2, c, d })
         })
         .collect();
-    let region: Vec<(Vec3, Vec3)> = candidates
+    let region: Vec<Aabb> = candidates
         .iter()
-        .map(|q| {
-            let q = [q.a, q.b, q.c, q.d].map(|v| mesh.positions[v as usize]);
-            (q.iter().fold(q[0], |m, &p| m.min(p)), q.iter().fold(q[0], |m, &p| m.max(p)))
-        })
+        .map(|q| Aabb::of_points(&[q.a, q.b, q.c, q.d].map(|v| mesh.positions[v as usize])))
         .collect();
     // Built on the first flip that gets as far as the crossing test.
     let mut nearby: Option<NearbyTriangles> = None;

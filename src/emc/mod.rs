@@ -275,12 +275,13 @@ fn crossing(
 
 /// The grid's cells in slabs of cell layers, four per thread at a time between checkpoints
 /// ([`crate::par`]; slabs through a part's detail take several times as long as others, and
-/// with one slab per thread each step waited for the slowest: extraction of the gear at 256 cells
-/// on two threads 150 -> 120 ms, median of five), joined as Marching Cubes joins its slabs ([`crate::mc::extract`]): a slab's
-/// vertices on its lowest point layer are the slab below's, so the mesh is the one sweep's,
-/// vertex for vertex, however the grid is cut. A crossing on a shared layer is computed by both
-/// slabs from the same edge and samples, so both decide their cells with the same point. On one
-/// thread the slabs are [`CHECKPOINT_LAYERS`] high, so a stop is seen that often.
+/// with one slab per thread each step waited for the slowest: extraction of the gear at 256
+/// cells on two threads 150 -> 120 ms, median of five), joined as Marching Cubes joins its slabs
+/// ([`crate::mc::extract`]): a slab's vertices on its lowest point layer are the slab below's,
+/// so the mesh is the one sweep's, vertex for vertex, however the grid is cut. A crossing on a
+/// shared layer is computed by both slabs from the same edge and samples, so both decide their
+/// cells with the same point. On one thread the slabs are [`CHECKPOINT_LAYERS`] high, so a stop
+/// is seen that often.
 fn extract(
     values: &[f32],
     grid: &Grid,

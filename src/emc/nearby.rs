@@ -13,6 +13,7 @@
 //! cells, recording all 400 000 triangles of the gear took 67 ms a pass, a third of the flips'
 //! time, for questions about a small share of them.
 
+use crate::mesh::analysis::bvh::Aabb;
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use crate::mesh::buckets::{bounds, TriangleBuckets};
 use crate::mesh::Mesh;
@@ -40,7 +41,7 @@ impl NearbyTriangles {
     /// that lie in it: a triangle that meets such a one reaches into the region, so it is
     /// recorded. Asking about a triangle outside the region is a caller's error (checked in debug
     /// builds).
-    pub fn around(mesh: &Mesh, spacing: Vec3, region: &[(Vec3, Vec3)]) -> NearbyTriangles {
+    pub fn around(mesh: &Mesh, spacing: Vec3, region: &[Aabb]) -> NearbyTriangles {
         let cell = spacing.max_element() as f64;
         let region = Region::new(cell, region);
         let boxes = (0..mesh.triangles.len()).map(|t| {
@@ -54,12 +55,6 @@ impl NearbyTriangles {
     pub fn insert(&mut self, t: u32, corners: &[Vec3; 3]) {
         let (lo, hi) = bounds(&corners64(corners));
         self.buckets.insert(t, lo, hi);
-    }
-
-    /// How many triangles are recorded.
-    #[cfg(test)]
-    fn buckets_recorded(&self) -> usize {
-        self.buckets.recorded()
     }
 
     /// Forgets triangle `t`.
@@ -130,10 +125,10 @@ impl Lattice {
 }
 
 impl Region {
-    fn new(cell: f64, boxes: &[(Vec3, Vec3)]) -> Region {
+    fn new(cell: f64, boxes: &[Aabb]) -> Region {
         let margin = 1e-2 * cell;
         let grown: Vec<(DVec3, DVec3)> =
-            boxes.iter().map(|&(lo, hi)| (lo.as_dvec3() - margin, hi.as_dvec3() + margin)).collect();
+            boxes.iter().map(|b| (b.min.as_dvec3() - margin, b.max.as_dvec3() + margin)).collect();
         let mut lattice = Lattice { cell, low: [0; 3], size: [0; 3] };
         if grown.is_empty() {
             return Region { lattice, bits: Vec::new() };
@@ -198,13 +193,13 @@ mod tests {
         let m = mesh();
         // A region around the first triangle only: the far one is not recorded, and a question
         // about the near one sees what the whole-mesh buckets see.
-        let region = [(Vec3::new(-0.5, -0.5, -0.5), Vec3::new(0.5, 0.5, 0.5))];
+        let region = [Aabb { min: Vec3::splat(-0.5), max: Vec3::splat(0.5) }];
         let mut around = NearbyTriangles::around(&m, Vec3::ONE, &region);
         let mut all = NearbyTriangles::new(&m, Vec3::ONE);
         let probe = [Vec3::new(0.2, 0.2, -0.4), Vec3::new(0.3, 0.2, 0.4), Vec3::new(0.2, 0.3, 0.4)];
         assert_eq!(around.near(&probe), all.near(&probe));
         assert!(around.crosses(&m, [10, 11, 12], &probe, &[]));
-        assert_eq!(around.buckets_recorded(), 1, "the far triangle is left out");
+        assert_eq!(around.buckets.recorded(), 1, "the far triangle is left out");
     }
 
     /// Random soups of small triangles (the sizes of EMC's, up to two cells), random regions of
@@ -223,10 +218,10 @@ mod tests {
                 }
                 mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
             }
-            let boxes: Vec<(Vec3, Vec3)> = (0..1 + rng.below(4))
+            let boxes: Vec<Aabb> = (0..1 + rng.below(4))
                 .map(|_| {
-                    let lo = rng.vec3(-1.0, 0.8);
-                    (lo, lo + rng.vec3(0.0, 3.0 * cell))
+                    let min = rng.vec3(-1.0, 0.8);
+                    Aabb { min, max: min + rng.vec3(0.0, 3.0 * cell) }
                 })
                 .collect();
             let spacing = Vec3::splat(cell);
@@ -238,8 +233,8 @@ mod tests {
             };
             for round in 0..2 {
                 for _ in 0..50 {
-                    let (lo, hi) = boxes[rng.below(boxes.len())];
-                    let question = [0; 3].map(|_: u8| lo + (hi - lo) * rng.vec3(0.0, 1.0));
+                    let b = boxes[rng.below(boxes.len())];
+                    let question = [0; 3].map(|_: u8| b.min + (b.max - b.min) * rng.vec3(0.0, 1.0));
                     assert_eq!(
                         sorted(around.near(&question)),
                         sorted(all.near(&question)),
@@ -248,9 +243,9 @@ mod tests {
                 }
                 // Move a few triangles that lie in a region box to other places in it.
                 for _ in 0..10 {
-                    let (lo, hi) = boxes[rng.below(boxes.len())];
+                    let b = boxes[rng.below(boxes.len())];
                     let t = rng.below(mesh.triangles.len());
-                    let corners = [0; 3].map(|_: u8| lo + (hi - lo) * rng.vec3(0.0, 1.0));
+                    let corners = [0; 3].map(|_: u8| b.min + (b.max - b.min) * rng.vec3(0.0, 1.0));
                     for (k, &p) in corners.iter().enumerate() {
                         mesh.positions[3 * t + k] = p;
                     }
@@ -266,7 +261,8 @@ mod tests {
     #[should_panic(expected = "asked outside the region")]
     fn asking_outside_the_region_is_an_error() {
         let m = mesh();
-        let mut around = NearbyTriangles::around(&m, Vec3::ONE, &[(Vec3::ZERO, Vec3::splat(0.5))]);
+        let mut around =
+            NearbyTriangles::around(&m, Vec3::ONE, &[Aabb { min: Vec3::ZERO, max: Vec3::splat(0.5) }]);
         around.near(&[Vec3::splat(5.2), Vec3::splat(5.3), Vec3::new(5.2, 5.3, 5.2)]);
     }
 

@@ -14,6 +14,7 @@
 use super::feature::FeatureKind;
 use super::nearby::NearbyTriangles;
 use super::placement::Placement;
+use crate::mesh::analysis::bvh::Aabb;
 use crate::mesh::Mesh;
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
@@ -50,18 +51,13 @@ pub fn pull_back_crossing_fans(
     // Questions are about these fans' triangles, each corner where it is or, for a centre that
     // may move, where it would go.
     let moves: HashMap<u32, Vec3> = fans.iter().map(|f| (f.vertex, f.inside.position)).collect();
-    let region: Vec<(Vec3, Vec3)> = incident
+    let region: Vec<Aabb> = incident
         .values()
         .flatten()
         .map(|&t| {
-            let corners = mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
-            let moved = mesh.triangles[t as usize]
-                .map(|v| moves.get(&v).copied().unwrap_or(mesh.positions[v as usize]));
-            let (lo, hi) = corners
-                .iter()
-                .chain(&moved)
-                .fold((corners[0], corners[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-            (lo, hi)
+            let tri = mesh.triangles[t as usize];
+            let moved = tri.map(|v| moves.get(&v).copied().unwrap_or(mesh.positions[v as usize]));
+            Aabb::of_points(&mesh.corners(t as usize)).union(Aabb::of_points(&moved))
         })
         .collect();
     let mut buckets = NearbyTriangles::around(mesh, spacing, &region);

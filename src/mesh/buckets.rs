@@ -133,7 +133,8 @@ impl TriangleBuckets {
     }
 
     /// How many triangles are recorded now.
-    pub fn recorded(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn recorded(&self) -> usize {
         self.present.iter().filter(|&&p| p).count()
     }
 
