@@ -108,10 +108,7 @@ impl Bvh {
 
     /// Calls `visit(i, j)` once for every unordered pair `i != j` of overlapping boxes.
     pub fn overlapping_pairs(&self, boxes: &[Aabb], visit: impl FnMut(u32, u32)) {
-        match self.overlapping_pairs_until(boxes, visit, || Ok::<(), std::convert::Infallible>(())) {
-            Ok(()) => {}
-            Err(never) => match never {},
-        }
+        let Ok(()) = self.overlapping_pairs_until(boxes, visit, || Ok::<(), std::convert::Infallible>(()));
     }
 
     /// [`Bvh::overlapping_pairs`] that calls `tick` every [`PAIRS_PER_TICK`] node pairs and stops

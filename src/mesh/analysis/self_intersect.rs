@@ -30,10 +30,8 @@ pub fn self_intersections(mesh: &Mesh) -> usize {
 
 /// The intersecting pairs `[i, j]` (triangle indices, `i < j`), sorted: for highlighting them.
 pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
-    match pairs_until(mesh, || Ok::<(), std::convert::Infallible>(())) {
-        Ok(pairs) => pairs,
-        Err(never) => match never {},
-    }
+    let Ok(pairs) = pairs_until(mesh, || Ok::<(), std::convert::Infallible>(()));
+    pairs
 }
 
 /// [`self_intersecting_pairs`] with a [`checkpoint`](crate::progress::checkpoint) every few

@@ -61,10 +61,8 @@ pub const CREASE_DEG: f64 = 30.0;
 /// of the normal statistics, as are faces where the gradient vanishes. An outward-facing mesh of a
 /// field that grows outward has deviations near 0; a flipped face shows up near 180 degrees.
 pub fn surface_error(mesh: &Mesh, field: &dyn Field) -> SurfaceError {
-    match measure(mesh, field, |_| Ok::<(), std::convert::Infallible>(())) {
-        Ok(error) => error,
-        Err(never) => match never {},
-    }
+    let Ok(error) = measure(mesh, field, |_| Ok::<(), std::convert::Infallible>(()));
+    error
 }
 
 /// [`surface_error`] with a [`checkpoint`](crate::progress::checkpoint) every few thousand faces:
