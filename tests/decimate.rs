@@ -6,8 +6,8 @@
 //! - every feature edge of the input (sampled along its length) stays within 1 % of a cell of the
 //!   output's feature lines;
 //! - with an error bound of twice undecimated EMC's largest distance, the triangle count drops by
-//!   10× or more (fandisk at 128; the cube minus a ball at 256, ignored for its time, since at 128
-//!   its curved part holds it to 8×).
+//!   10× or more (fandisk and the cube minus a ball at 128; the cube minus a ball at 256 too,
+//!   ignored for its time).
 //!
 //! Heavy cases are `#[ignore]`d: `cargo test --release --test decimate -- --ignored --nocapture`.
 
@@ -16,6 +16,7 @@ mod common;
 use common::csg::random_tree;
 use common::{case_seeds, Rng};
 use isoforge::expr;
+use isoforge::field::Field;
 use isoforge::mesh::analysis::{self, Topology};
 use isoforge::pipeline::{self, Method, Output, Request};
 use isoforge::stats::AnalysisOptions;
@@ -141,14 +142,15 @@ fn fandisk_at_128_loses_ninety_percent_of_its_triangles_within_twice_emcs_error(
     assert!(error_after <= 2.0 * error_before * 1.01, "{error_before} -> {error_after}");
 }
 
-/// At 128 the ball's curvature bounds the triangles' size: vertices on a ball of radius 0.75 and
-/// faces within 0.0002 of it need about 7 000 triangles on the ball alone, so 8× is what is there.
+/// At 128 the ball's curvature bounds the triangles' size: with every vertex on the ball, faces
+/// within 0.0002 of it need about 7 000 triangles on the ball alone; the vertices placed off it
+/// against their faces' sag (and evened out between rounds) bring the whole part to about 7 300.
 #[test]
 // Seconds natively, a minute in the browser: the ratio does not depend on the target.
 #[cfg_attr(target_arch = "wasm32", ignore)]
-fn cube_minus_sphere_at_128_loses_most_of_its_triangles_within_twice_emcs_error() {
+fn cube_minus_sphere_at_128_loses_ninety_percent_of_its_triangles_within_twice_emcs_error() {
     let (before, error_before, after, error_after) = ratio_at_twice_the_error("cube_minus_sphere", 128);
-    assert!(after * 15 <= before * 2, "{before} -> {after} triangles: under 7.5×");
+    assert!(after * 10 <= before, "{before} -> {after} triangles");
     assert!(error_after <= 2.0 * error_before * 1.01, "{error_before} -> {error_after}");
 }
 
@@ -190,22 +192,75 @@ fn smoothing_leaves_features_and_distance_and_evens_out_normals() {
     assert!(moved * 2 > input.mesh.vertex_count(), "only {moved} vertices moved: smoothing did nothing");
 }
 
+/// The random CSG tree of `seed` (see `props_csg.rs`) compiled, a resolution of 16–32 cells for
+/// it, and both named for messages.
+fn random_case(seed: u64) -> (expr::Program, usize, String) {
+    let mut rng = Rng::new(seed);
+    let tree = random_tree(&mut rng);
+    let program = expr::compile(&tree.text).unwrap();
+    let res = 16 + rng.below(17) as usize;
+    (program, res, format!("seed {seed}, res {res}: {}", tree.text))
+}
+
 /// Seeded random CSG trees (see `props_csg.rs`), EMC at 16–32 cells, decimated to a quarter:
 /// still an oriented manifold with the input's border, topology and creases, no crossings.
 #[test]
 fn prop_decimated_emc_of_random_trees_keeps_its_promises() {
     for seed in case_seeds(0xDEC1_0000, 12) {
-        let mut rng = Rng::new(seed);
-        let tree = random_tree(&mut rng);
-        let program = expr::compile(&tree.text).unwrap();
-        let res = 16 + rng.below(17) as usize;
-        let what = format!("seed {seed}, res {res}: {}", tree.text);
+        let (program, res, what) = random_case(seed);
         let input = pipeline::mesh_program(&program, &request(res)).unwrap();
         let target = input.mesh.triangle_count() / 4;
         let output =
             pipeline::mesh_program(&program, &Request { decimate: Some(target.max(1)), ..request(res) })
                 .unwrap_or_else(|e| panic!("{what}: {e}"));
         assert_kept(&input, &output, 2.0 / res as f32, &what);
+    }
+}
+
+/// The largest `|f| / |∇f|` (the decimation guard's distance estimate) over the vertices, the
+/// face centroids and the points halfway from each centroid to its corners.
+fn largest_estimated_distance(mesh: &isoforge::Mesh, field: &dyn Field) -> f64 {
+    let estimate = |p: Vec3| {
+        let (value, gradient) = field.value_and_gradient(p);
+        let g = gradient.expect("programs have exact gradients").length();
+        if g > 1e-12 {
+            (value / g).abs() as f64
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut worst = mesh.positions.iter().map(|&p| estimate(p)).fold(0.0, f64::max);
+    for t in 0..mesh.triangle_count() {
+        let c = mesh.corners(t);
+        let centre = (c[0] + c[1] + c[2]) / 3.0;
+        worst = c.iter().map(|&x| estimate(0.5 * (centre + x))).fold(worst.max(estimate(centre)), f64::max);
+    }
+    worst
+}
+
+/// Seeded random CSG trees, EMC at 16–32 cells decimated as far as twice EMC's own largest
+/// distance estimate allows: the vertices placed off the surface, the alternative placements and
+/// the relaxing rounds keep every vertex and face sample within the bound, and the mesh keeps its
+/// promises. Fails if a move skips the distance check or an offset overshoots.
+#[test]
+fn prop_decimated_emc_of_random_trees_stays_within_its_error_bound() {
+    for seed in case_seeds(0xDEC2_0000, 10) {
+        let (program, res, what) = random_case(seed);
+        let cell = 2.0 / res as f32;
+        let input = pipeline::mesh_program(&program, &request(res)).unwrap();
+        if input.mesh.triangle_count() == 0 {
+            continue;
+        }
+        let before = largest_estimated_distance(&input.mesh, &program);
+        let bound = 2.0 * before;
+        let bounded =
+            Request { decimate: Some(1), decimate_error: Some(bound as f32 / cell), ..request(res) };
+        let output = pipeline::mesh_program(&program, &bounded).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_kept(&input, &output, cell, &what);
+        let after = largest_estimated_distance(&output.mesh, &program);
+        // 1 % and a hair over for the f32 rounding of the written mesh.
+        assert!(after <= bound * 1.01 + 1e-6, "{what}: {before} -> {after}, bound {bound}");
+        assert!(output.mesh.triangle_count() < input.mesh.triangle_count(), "{what}: nothing collapsed");
     }
 }
 

@@ -3,7 +3,7 @@
 //! tolerance, no face turns over, degenerates or gets a new sliver, no new face crosses another,
 //! and with a field, no face sample leaves the error bound.
 
-use super::{bounds, key, min_angle, segment_distance, State};
+use super::{bounds, key, min_angle, segment_distance, Kind, State};
 use crate::field::finite_difference_gradient;
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use glam::DVec3;
@@ -14,11 +14,15 @@ pub(super) struct Plan {
     pub(super) removed: Vec<u32>,
     pub(super) changed: Vec<(u32, [u32; 3])>,
     pub(super) line: Option<(u32, Vec<DVec3>)>,
+    /// Where the kept vertex goes.
+    pub(super) target: DVec3,
 }
 
 impl State<'_> {
-    /// Everything a collapse must pass (see the module doc); the faces it rewrites if it does.
-    pub(super) fn check(&mut self, u: u32, v: u32, p: DVec3) -> Option<Plan> {
+    /// Everything a collapse of `u` into `v` must pass (see the module doc), tried at each of
+    /// `placements` for `v` in turn; the faces it rewrites and where `v` goes for the first that
+    /// passes.
+    pub(super) fn check(&mut self, u: u32, v: u32, placements: &[DVec3]) -> Option<Plan> {
         let fan_u = self.faces_of[u as usize].clone();
         let fan_v = self.faces_of[v as usize].clone();
         let removed: Vec<u32> =
@@ -36,13 +40,41 @@ impl State<'_> {
             return None;
         }
         let line = self.line_check(u, v)?;
-        let at = |w: u32| if w == v { p } else { self.pos[w as usize] };
         let old_min =
             fan_u.iter().chain(&fan_v).map(|&f| min_angle(&self.corners(f))).fold(f64::INFINITY, f64::min);
         let floor = self.options.min_angle_deg.to_radians().min(old_min);
+        let free = self.kind[u as usize] == Kind::Free && self.kind[v as usize] == Kind::Free;
+        for &p in placements {
+            // The cheap, purely geometric checks first: most refusals are new slivers.
+            let Some(corners) = self.reshaped(&changed, v, p, floor) else { continue };
+            let balanced = if free { self.balanced(p, &corners) } else { p };
+            let (p, corners) = match self.reshaped(&changed, v, balanced, floor) {
+                Some(moved) if balanced != p => (balanced, moved),
+                _ => (p, corners),
+            };
+            if self.within_error(p, &corners) && !self.crosses(&changed, &corners, &removed) {
+                return Some(Plan { removed, changed, line, target: p });
+            }
+        }
+        None
+    }
+
+    /// The corners of faces `changed` with vertex `v` at `p`, unless one of them degenerates, gets
+    /// an angle under `floor` or turns by more than [`DecimateOptions::max_normal_turn_deg`] from
+    /// the face it rewrites.
+    ///
+    /// [`DecimateOptions::max_normal_turn_deg`]: super::DecimateOptions::max_normal_turn_deg
+    pub(super) fn reshaped(
+        &self,
+        changed: &[(u32, [u32; 3])],
+        v: u32,
+        p: DVec3,
+        floor: f64,
+    ) -> Option<Vec<[DVec3; 3]>> {
+        let at = |w: u32| if w == v { p } else { self.pos[w as usize] };
         let cos_turn = self.options.max_normal_turn_deg.to_radians().cos();
-        let mut new_corners = Vec::with_capacity(changed.len());
-        for &(f, t) in &changed {
+        let mut corners = Vec::with_capacity(changed.len());
+        for &(f, t) in changed {
             let c = t.map(at);
             let n_new = (c[1] - c[0]).cross(c[2] - c[0]);
             if n_new.length_squared() <= self.tiny_area || min_angle(&c) < floor {
@@ -50,20 +82,12 @@ impl State<'_> {
             }
             let old = self.corners(f);
             let n_old = (old[1] - old[0]).cross(old[2] - old[0]);
-            if let Some(o) = n_old.try_normalize() {
-                if o.dot(n_new.normalize()) < cos_turn {
-                    return None;
-                }
+            if n_old.try_normalize().is_some_and(|o| o.dot(n_new.normalize()) < cos_turn) {
+                return None;
             }
-            new_corners.push(c);
+            corners.push(c);
         }
-        if !self.within_error(p, &new_corners) {
-            return None;
-        }
-        if self.crosses(&changed, &new_corners, &removed) {
-            return None;
-        }
-        Some(Plan { removed, changed, line })
+        Some(corners)
     }
 
     /// Whether any of the rewritten faces `changed` (at `corners`) crosses another of them or a

@@ -12,7 +12,11 @@
 //!   out to their corners and curved ones keep the vertices they need);
 //! - a free vertex merges into a constrained one at the constrained one's position, and two free
 //!   vertices meet at the point of least quadric error (feature-edge quadrics, planes through each
-//!   crease perpendicular to its faces, pull the optimum away from the lines).
+//!   crease perpendicular to its faces, pull the optimum away from the lines); with a field, that
+//!   point then moves off the surface against its faces' sag (`balance`), and under an error
+//!   bound the midpoint and the two ends are tried where it fails;
+//! - where the collapses stop short of the target, rounds of evening out the free vertices
+//!   (`relax`) and collapsing again follow.
 //!
 //! Every collapse is checked before it is made (see `check`): the link condition and the local
 //! edge orientations (the mesh stays a closed oriented 2-manifold of the same Euler
@@ -22,9 +26,11 @@
 //! the faces and the analysis's exact triangle-pair test), and with a field, no new vertex or face
 //! sample farther than [`DecimateOptions::max_error`] from the zero set.
 
+mod balance;
 mod check;
 mod flip;
 mod quadric;
+mod relax;
 
 use crate::error::Error;
 use crate::field::Field;
@@ -101,9 +107,32 @@ pub fn decimate(
 ) -> Result<Decimated, Error> {
     let mut state = State::new(mesh, feature_edges, field, options);
     state.run()?;
+    // Where the collapses stop short of the target for the error bound, the free vertices move
+    // towards their neighbours' centre (on the surface, balanced against their faces' sag) and
+    // the collapses refused are tried again: a round of greedy collapses leaves triangles of
+    // uneven size, the small ones kept only because a neighbour is too large to grow.
+    for _ in 0..MAX_ROUNDS {
+        let before = state.alive_count;
+        if before <= options.target_triangles || field.is_none() {
+            break;
+        }
+        state.relax();
+        state.push_all();
+        state.run()?;
+        if (before - state.alive_count) * ROUND_GAIN < before {
+            break;
+        }
+    }
     state.improve_angles();
     Ok(state.finish(mesh))
 }
+
+/// Rounds of relaxing and collapsing again after the first pass, at most; on the cube minus a
+/// ball at 128 cells with twice EMC's error as the bound, the first three take 8 182 triangles
+/// to 7 590, 7 500 and 7 440.
+const MAX_ROUNDS: usize = 3;
+/// Another round follows only while the last one removed more than one in this many triangles.
+const ROUND_GAIN: usize = 100;
 
 /// Heap entries looked at between two checkpoints.
 const POPS_PER_CHECKPOINT: usize = 4096;
@@ -204,14 +233,19 @@ impl<'a> State<'a> {
         state.classify(feature_edges);
         state.init_quadrics();
         state.init_grid();
-        for v in 0..n as u32 {
-            for w in state.neighbours(v) {
+        state.push_all();
+        state
+    }
+
+    /// Every edge's cheapest allowed collapse onto the heap.
+    fn push_all(&mut self) {
+        for v in 0..self.pos.len() as u32 {
+            for w in self.neighbours(v) {
                 if v < w {
-                    state.push(v, w);
+                    self.push(v, w);
                 }
             }
         }
-        state
     }
 
     fn corners(&self, f: u32) -> [DVec3; 3] {
@@ -434,14 +468,27 @@ impl<'a> State<'a> {
                     continue;
                 }
             }
-            if let Some(plan) = self.check(c.remove, c.keep, c.target) {
-                self.apply(c.remove, c.keep, c.target, plan);
+            // Under an error bound, two free vertices may also meet halfway or at either end
+            // where the quadric's best point makes a sliver or sags too far; without one, the
+            // edge's cost stands only for the point it was computed at.
+            let mut placements = vec![c.target];
+            let bounded = self.options.max_error.is_some() && self.field.is_some();
+            if bounded && self.kind[r] == Kind::Free && self.kind[k] == Kind::Free {
+                for p in [0.5 * (self.pos[r] + self.pos[k]), self.pos[k], self.pos[r]] {
+                    if !placements.contains(&p) {
+                        placements.push(p);
+                    }
+                }
+            }
+            if let Some(plan) = self.check(c.remove, c.keep, &placements) {
+                self.apply(c.remove, c.keep, plan);
             }
         }
         Ok(())
     }
 
-    fn apply(&mut self, u: u32, v: u32, p: DVec3, plan: Plan) {
+    fn apply(&mut self, u: u32, v: u32, plan: Plan) {
+        let p = plan.target;
         for &f in &plan.removed {
             self.alive[f as usize] = false;
             self.grid.remove(f);
