@@ -7,16 +7,19 @@
 //! and Taubin's inflating μ step cancels the shrinking. With a field the relaxation becomes a
 //! tangential one: each moved vertex is pulled back onto the zero set, so the triangles even out
 //! while the distance error does not grow. A vertex stays where it was if its move would turn one
-//! of its faces by more than 60°, give it a new sliver (see `turned`), or (with a field) put a sample of one of its faces (centroid, and
-//! halfway to each corner) farther from the surface than the farthest was before smoothing: next to
-//! a crease, a relaxed and projected vertex can land on the other sheet.
+//! of its faces by more than 60°, give it a new sliver (see `turned`), make it cross a face it did
+//! not cross before, or (with a field) put a sample of one of its faces (centroid, and halfway to
+//! each corner) farther from the surface than the farthest was before smoothing: next to a crease,
+//! a relaxed and projected vertex can land on the other sheet. Where undoing such moves does not
+//! settle in a few rounds, the whole step is undone.
 
 use crate::error::Error;
 use crate::field::{finite_difference_gradient, Field};
+use crate::mesh::analysis::self_intersect::self_intersecting_pairs_within;
 use crate::mesh::Mesh;
 use crate::progress::checkpoint;
 use glam::Vec3;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// Taubin's weights: a shrinking step of λ, then an inflating one of μ (|μ| slightly above λ).
 const LAMBDA: f32 = 0.5;
@@ -75,6 +78,8 @@ pub fn smooth(
         (Some(field), Some(bound)) => face_distance(field, mesh, f, step) > bound,
         _ => false,
     };
+    let crossing_before: HashSet<[u32; 2]> =
+        self_intersecting_pairs_within(mesh, "smooth", 0.0)?.into_iter().collect();
     let mut moved = vec![false; n];
     for pass in 0..passes {
         checkpoint("smooth", pass as f32 / passes as f32)?;
@@ -95,8 +100,11 @@ pub fn smooth(
                     }
                 }
             }
-            // Undo the moves that turn a face over; undoing one can spoil a neighbour, so repeat.
-            for _ in 0..4 {
+            // Undo the moves that turn a face over, squeeze it, take it too far from the surface
+            // or make it cross another; undoing one can spoil a neighbour, so repeat, and where
+            // that does not settle, undo the whole step: the mesh before it passed all four.
+            let mut settled = false;
+            for _ in 0..UNDO_ROUNDS {
                 let mut undone = false;
                 let mut bad = vec![None; mesh.triangles.len()];
                 for v in 0..n {
@@ -111,9 +119,22 @@ pub fn smooth(
                         undone = true;
                     }
                 }
-                if !undone {
+                if undone {
+                    continue;
+                }
+                let crossing = new_crossings(mesh, &crossing_before, pass as f32 / passes as f32)?;
+                if crossing.is_empty() {
+                    settled = true;
                     break;
                 }
+                for f in crossing.into_iter().flatten() {
+                    for v in mesh.triangles[f as usize] {
+                        mesh.positions[v as usize] = before[v as usize];
+                    }
+                }
+            }
+            if !settled {
+                mesh.positions.copy_from_slice(&before);
             }
             for v in 0..n {
                 moved[v] |= mesh.positions[v] != before[v];
@@ -130,6 +151,21 @@ pub fn smooth(
         }
     }
     Ok(())
+}
+
+/// Rounds of undoing moves before a step is undone whole.
+const UNDO_ROUNDS: usize = 6;
+
+/// The pairs of faces that cross now and not in `crossing_before` (the input's own).
+fn new_crossings(
+    mesh: &Mesh,
+    crossing_before: &HashSet<[u32; 2]>,
+    done: f32,
+) -> Result<Vec<[u32; 2]>, Error> {
+    Ok(self_intersecting_pairs_within(mesh, "smooth", done)?
+        .into_iter()
+        .filter(|pair| !crossing_before.contains(pair))
+        .collect())
 }
 
 /// Whether face `f` now points more than 60° away from where it pointed at `before`, lost its

@@ -38,7 +38,17 @@ pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
 /// thousand box pairs: on the page it runs after every mesh, and a newer request must be able to
 /// stop it within milliseconds, not wait for it.
 pub fn self_intersecting_pairs_cancellable(mesh: &Mesh) -> Result<Vec<[u32; 2]>, crate::Error> {
-    pairs_until(mesh, || crate::progress::checkpoint("analysis", 0.0))
+    self_intersecting_pairs_within(mesh, "analysis", 0.0)
+}
+
+/// [`self_intersecting_pairs_cancellable`] as a step of another phase, whose checkpoints report
+/// `phase` at `fraction` done.
+pub fn self_intersecting_pairs_within(
+    mesh: &Mesh,
+    phase: &'static str,
+    fraction: f32,
+) -> Result<Vec<[u32; 2]>, crate::Error> {
+    pairs_until(mesh, || crate::progress::checkpoint(phase, fraction))
 }
 
 fn pairs_until<E>(mesh: &Mesh, tick: impl FnMut() -> Result<(), E>) -> Result<Vec<[u32; 2]>, E> {
