@@ -319,20 +319,20 @@ fn sliver_share(mesh: &isoforge::Mesh) -> f64 {
 }
 
 /// The goal, fewer than 2 % of the triangles under 10° without moving a feature point,
-/// where EMC has 6.0 % (cube minus a ball, decimated: 0 %) and 15.8 % (rotated box: 1.3 %) at 64
-/// cells; the fandisk goes from 0.9 % to 2.0 %, its fixed feature vertices keeping their slivers
-/// as the rest thins out. Not the gear: its teeth's fans keep 9.6 % (docs/decimate.md).
+/// where EMC has 6.0 % (cube minus a ball, decimated: 0 %), 15.8 % (rotated box: 0.6 %) and
+/// 0.9 % (fandisk: 1.8 %, its fixed feature vertices keeping their slivers as the rest thins out)
+/// at 64 cells. Not the gear: its teeth's fans keep 7.7 % (docs/decimate.md).
 #[test]
 #[cfg_attr(target_arch = "wasm32", ignore)]
 fn decimation_to_a_tenth_leaves_few_slivers() {
-    for (name, most) in [("cube_minus_sphere", 0.02), ("rotated_box", 0.02), ("fandisk", 0.025)] {
+    for name in ["cube_minus_sphere", "rotated_box", "fandisk"] {
         let res = 64;
         let input = pipeline::mesh_scene(name, &request(res)).unwrap();
         let target = input.mesh.triangle_count() / 10;
         let output = pipeline::mesh_scene(name, &Request { decimate: Some(target), ..request(res) }).unwrap();
         let (before, after) = (sliver_share(&input.mesh), sliver_share(&output.mesh));
         eprintln!("{name}: {:.1} % -> {:.1} % under 10°", 100.0 * before, 100.0 * after);
-        assert!(after < most, "{name}: {:.1} % of the triangles under 10°", 100.0 * after);
+        assert!(after < 0.02, "{name}: {:.1} % of the triangles under 10°", 100.0 * after);
         assert_kept(&input, &output, scene_cell(name, res), name);
     }
 }

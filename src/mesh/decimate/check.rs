@@ -42,7 +42,8 @@ impl State<'_> {
         let line = self.line_check(u, v)?;
         let old_min =
             fan_u.iter().chain(&fan_v).map(|&f| min_angle(&self.corners(f))).fold(f64::INFINITY, f64::min);
-        let floor = self.options.min_angle_deg.to_radians().min(old_min);
+        let floor =
+            self.options.min_angle_deg.to_radians().min(old_min.max(self.sliver_floor.unwrap_or(0.0)));
         let free = self.kind[u as usize] == Kind::Free && self.kind[v as usize] == Kind::Free;
         for &p in placements {
             // The cheap, purely geometric checks first: most refusals are new slivers.
@@ -175,6 +176,16 @@ impl State<'_> {
     pub(super) fn within_error(&self, p: DVec3, faces: &[[DVec3; 3]]) -> bool {
         let Some(bound) = self.options.max_error else { return true };
         self.field.is_none() || (self.distance(p) <= bound && self.face_distance(faces) <= bound)
+    }
+
+    /// The largest distance estimate over the surviving faces, their samples and corners.
+    pub(super) fn largest_distance(&self) -> f64 {
+        let faces: Vec<[DVec3; 3]> = (0..self.tris.len() as u32)
+            .filter(|&f| self.alive[f as usize])
+            .map(|f| self.corners(f))
+            .collect();
+        let corners = faces.iter().flatten().map(|&p| self.distance(p)).fold(0.0, f64::max);
+        corners.max(self.face_distance(&faces))
     }
 
     /// The largest distance estimate over the faces' samples: each centroid and the points halfway

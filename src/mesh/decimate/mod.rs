@@ -28,9 +28,9 @@
 
 mod balance;
 mod check;
-mod flip;
 mod quadric;
 mod relax;
+mod slivers;
 
 use crate::error::Error;
 use crate::field::Field;
@@ -123,6 +123,13 @@ pub fn decimate(
             break;
         }
     }
+    // The slivers' passes trade no distance for angles: under the bound if one was given, or
+    // else under the largest distance the collapses left.
+    if field.is_some() && options.max_error.is_none() {
+        let worst = state.largest_distance();
+        state.options.max_error = Some(worst);
+    }
+    state.collapse_slivers();
     state.improve_angles();
     Ok(state.finish(mesh))
 }
@@ -187,6 +194,8 @@ struct State<'a> {
     tiny_area: f64,
     fd_step: f32,
     collapses: usize,
+    /// While slivers are collapsed (see `slivers`): new angles must exceed this one.
+    sliver_floor: Option<f64>,
 }
 
 impl<'a> State<'a> {
@@ -229,6 +238,7 @@ impl<'a> State<'a> {
             tiny_area: (1e-12 * diagonal * diagonal).powi(2),
             fd_step: (1e-4 * diagonal).max(1e-6) as f32,
             collapses: 0,
+            sliver_floor: None,
         };
         state.classify(feature_edges);
         state.init_quadrics();
