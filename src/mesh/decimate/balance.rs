@@ -9,6 +9,7 @@
 //! twice as large in area for the same maximum distance. The quadric optimum already leans that
 //! way, but only by what the original faces' planes say, not by what the field measures.
 
+use super::check::face_samples;
 use super::State;
 use glam::DVec3;
 
@@ -25,9 +26,12 @@ impl State<'_> {
         let mut lines = vec![(s_p, 1.0)];
         for c in faces {
             let Some(at) = c.iter().position(|&x| x == p) else { continue };
-            let centre = (c[0] + c[1] + c[2]) / 3.0;
-            let halfway = |i: usize| (0.5 * (centre + c[i]), if i == at { 2.0 / 3.0 } else { 1.0 / 6.0 });
-            for (x, share) in [(centre, 1.0 / 3.0), halfway(0), halfway(1), halfway(2)] {
+            for (k, x) in face_samples(c).into_iter().enumerate() {
+                let share = match k {
+                    0 => 1.0 / 3.0,
+                    k if k - 1 == at => 2.0 / 3.0,
+                    _ => 1.0 / 6.0,
+                };
                 let Some((s, g)) = self.signed_distance(x) else { return p };
                 lines.push((s, share * g.dot(normal)));
             }
@@ -54,13 +58,9 @@ impl State<'_> {
 
     /// `f / |∇f|` at `x` (the signed distance, for a distance field) and the unit normal there.
     pub(super) fn signed_distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        let field = self.field?;
-        let at = x.as_vec3();
-        let gradient = field
-            .gradient(at)
-            .unwrap_or_else(|| crate::field::finite_difference_gradient(field, at, self.fd_step))
-            .as_dvec3();
+        let (value, gradient) = self.value_and_gradient(x)?;
+        let gradient = gradient.as_dvec3();
         let length = gradient.length();
-        (length > 1e-12).then(|| (field.value(at) as f64 / length, gradient / length))
+        (length > 1e-12).then(|| (value as f64 / length, gradient / length))
     }
 }

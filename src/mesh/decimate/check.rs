@@ -6,7 +6,7 @@
 use super::{bounds, key, min_angle, segment_distance, Kind, State};
 use crate::field::finite_difference_gradient;
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 /// The faces a checked collapse deletes and rewrites, and for a collapse along a feature line the
 /// line's far vertex and the new feature edge's original points.
@@ -107,17 +107,23 @@ impl State<'_> {
             }
         }
         let changed_ids: Vec<u32> = changed.iter().map(|c| c.0).collect();
+        // One query over the whole fan rather than one per face: the fan's faces share most of
+        // their neighbours, and a query costs a search per cube it touches.
+        let boxes: Vec<(DVec3, DVec3)> = corners.iter().map(bounds).collect();
+        let (lo, hi) =
+            boxes.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), b| (l.min(b.0), h.max(b.1)));
         let mut nearby = Vec::new();
-        for (i, &(_, t)) in changed.iter().enumerate() {
-            let (lo, hi) = bounds(&corners[i]);
-            nearby.clear();
-            self.grid.query(lo, hi, &mut nearby);
-            for &g in &nearby {
-                if !self.alive[g as usize] || removed.contains(&g) || changed_ids.contains(&g) {
-                    continue;
-                }
-                let c = self.corners(g);
-                if indexed_pair_intersects((t, corners[i]), (self.tris[g as usize], c)) {
+        self.grid.query(lo, hi, &mut nearby);
+        for &g in &nearby {
+            if !self.alive[g as usize] || removed.contains(&g) || changed_ids.contains(&g) {
+                continue;
+            }
+            let c = self.corners(g);
+            let (g_lo, g_hi) = bounds(&c);
+            for (i, &(_, t)) in changed.iter().enumerate() {
+                let (f_lo, f_hi) = boxes[i];
+                let overlap = f_lo.cmple(g_hi).all() && g_lo.cmple(f_hi).all();
+                if overlap && indexed_pair_intersects((t, corners[i]), (self.tris[g as usize], c)) {
                     return true;
                 }
             }
@@ -172,10 +178,12 @@ impl State<'_> {
     }
 
     /// With a field: the new vertex and the sample points of the new faces within
-    /// [`DecimateOptions::max_error`] of the zero set.
+    /// [`DecimateOptions::max_error`] of the zero set (the first sample outside ends the check).
     pub(super) fn within_error(&self, p: DVec3, faces: &[[DVec3; 3]]) -> bool {
         let Some(bound) = self.options.max_error else { return true };
-        self.field.is_none() || (self.distance(p) <= bound && self.face_distance(faces) <= bound)
+        self.field.is_none()
+            || (self.distance(p) <= bound
+                && faces.iter().all(|c| face_samples(c).iter().all(|&x| self.distance(x) <= bound)))
     }
 
     /// The largest distance estimate over the surviving faces, their samples and corners.
@@ -192,25 +200,22 @@ impl State<'_> {
     /// from it to the corners, what [`crate::mesh::analysis::surface_error()`] measures inside a
     /// face. 0 without a field.
     pub(super) fn face_distance(&self, faces: &[[DVec3; 3]]) -> f64 {
-        let mut worst = 0.0f64;
-        for c in faces {
-            let centre = (c[0] + c[1] + c[2]) / 3.0;
-            worst = worst.max(self.distance(centre));
-            for &corner in c {
-                worst = worst.max(self.distance(0.5 * (centre + corner)));
-            }
-        }
-        worst
+        faces.iter().flat_map(face_samples).map(|x| self.distance(x)).fold(0.0, f64::max)
+    }
+
+    /// The field's value and gradient at `x` from one evaluation (a compiled program's forward
+    /// pass gives both), the gradient by central differences where the field has none.
+    pub(super) fn value_and_gradient(&self, x: DVec3) -> Option<(f32, Vec3)> {
+        let field = self.field?;
+        let x = x.as_vec3();
+        let (value, gradient) = field.value_and_gradient(x);
+        Some((value, gradient.unwrap_or_else(|| finite_difference_gradient(field, x, self.fd_step))))
     }
 
     /// One Newton step's estimate of the distance from `x` to the field's zero set, `|f| / |∇f|`
     /// (exact for signed distances); 0 without a field.
     pub(super) fn distance(&self, x: DVec3) -> f64 {
-        let Some(field) = self.field else { return 0.0 };
-        let x = x.as_vec3();
-        let value = field.value(x);
-        let gradient =
-            field.gradient(x).unwrap_or_else(|| finite_difference_gradient(field, x, self.fd_step));
+        let Some((value, gradient)) = self.value_and_gradient(x) else { return 0.0 };
         let g = gradient.length();
         if g > 1e-12 {
             (value / g).abs() as f64
@@ -218,4 +223,11 @@ impl State<'_> {
             f64::INFINITY
         }
     }
+}
+
+/// The points of a face where its distance is measured: the centroid and the points halfway from
+/// it to each corner, what [`crate::mesh::analysis::surface_error()`] samples inside a face.
+pub(super) fn face_samples(c: &[DVec3; 3]) -> [DVec3; 4] {
+    let centre = (c[0] + c[1] + c[2]) / 3.0;
+    [centre, 0.5 * (centre + c[0]), 0.5 * (centre + c[1]), 0.5 * (centre + c[2])]
 }

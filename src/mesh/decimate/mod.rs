@@ -188,6 +188,8 @@ struct State<'a> {
     lines: HashMap<(u32, u32), Vec<DVec3>>,
     line_neighbours: Vec<Vec<u32>>,
     grid: TriangleBuckets,
+    /// The faces alive when `grid` was built.
+    grid_faces: usize,
     heap: BinaryHeap<Candidate>,
     field: Option<&'a dyn Field>,
     options: DecimateOptions,
@@ -228,6 +230,7 @@ impl<'a> State<'a> {
             lines: HashMap::new(),
             line_neighbours: vec![Vec::new(); n],
             grid: TriangleBuckets::build(1.0, std::iter::empty()),
+            grid_faces: 0,
             heap: BinaryHeap::new(),
             alive_count: alive.iter().filter(|&&a| a).count(),
             pos,
@@ -395,6 +398,7 @@ impl<'a> State<'a> {
         let boxes: Vec<(DVec3, DVec3)> =
             (0..self.tris.len() as u32).map(|f| bounds(&self.corners(f))).collect();
         self.grid = TriangleBuckets::build(4.0 * mean, boxes.into_iter());
+        self.grid_faces = self.alive_count;
         for f in 0..self.tris.len() as u32 {
             if !self.alive[f as usize] {
                 self.grid.remove(f);
@@ -493,6 +497,11 @@ impl<'a> State<'a> {
             }
             if let Some(plan) = self.check(c.remove, c.keep, &placements) {
                 self.apply(c.remove, c.keep, plan);
+                // Faces grow as they go: buckets sized for the first ones would record each
+                // survivor in dozens of cubes and make every crossing query scan them.
+                if 2 * self.alive_count < self.grid_faces {
+                    self.init_grid();
+                }
             }
         }
         Ok(())
