@@ -12,7 +12,7 @@ import { showReference } from './reference.js';
 const $ = (id) => document.getElementById(id);
 const DEFAULT_SCENE = 'cube_minus_sphere';
 /** Options kept in the session and the link, by input id. */
-const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth', 'decimate'];
+const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth', 'decimate', 'smooth'];
 const CHECKS = ['auto-bounds', 'live', 'wireframe', 'features', 'normals', 'bad'];
 
 await init();
@@ -97,8 +97,13 @@ function fitBounds() {
 function options(method, bounds) {
   // The error numbers come after the mesh is shown (Pane.measure), not with it.
   const target = Number($('decimate').value);
-  // Quads would be broken up by decimation, which the library refuses for them.
-  const common = target >= 1 && method !== 'quad' ? { bounds, decimate: Math.floor(target) } : { bounds };
+  const passes = Math.min(100, Math.floor(Number($('smooth').value)));
+  // Quads would be broken up by decimation and smoothing, which the library refuses for them.
+  const common = { bounds };
+  if (method !== 'quad') {
+    if (target >= 1) common.decimate = Math.floor(target);
+    if (passes >= 1) common.smooth = passes;
+  }
   if (method === 'dmc') {
     return { ...common, tolerance: Number($('tol').value), maxDepth: Number($('depth').value) };
   }
@@ -255,7 +260,7 @@ for (const id of ['theta', 'phi']) {
   });
   $(`${id}-slider`).addEventListener('change', optionChanged);
 }
-for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate']) {
+for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate', 'smooth']) {
   $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }
 for (const id of ['theta', 'phi']) $(id).addEventListener('input', showAngles);

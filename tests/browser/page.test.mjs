@@ -172,6 +172,30 @@ test('sliders set the options they stand beside: an angle in degrees becomes its
   assert.ok(await count(page, LEFT, 'feature edges') >= loose);
 });
 
+test('"Smooth" relaxes both sides without moving a feature line or opening the mesh, and is kept in the link', async () => {
+  const { page } = await openDemo();
+  const edges = await count(page, LEFT, 'feature edges');
+  const triangles = await count(page, LEFT, 'triangles');
+  const shape = async () => [await stat(page, RIGHT, 'smallest angle (°)'), await stat(page, RIGHT, 'RMS distance')];
+  const unsmoothed = await shape();
+  await page.fill('#smooth', '3');
+  await page.click('#run');
+  await settled(page);
+  for (const side of [LEFT, RIGHT]) {
+    assert.equal(await stat(page, side, 'closed manifold'), 'yes', side);
+    assert.equal(await stat(page, side, 'Euler characteristic'), '-8', side);
+    assert.equal(await count(page, side, 'crossing pairs'), 0, side);
+  }
+  assert.equal(await count(page, LEFT, 'feature edges'), edges, 'EMC keeps its feature lines');
+  assert.equal(await count(page, LEFT, 'triangles'), triangles, 'smoothing moves vertices only');
+  assert.notDeepEqual(await shape(), unsmoothed, 'the right pane\'s triangles changed shape');
+  const link = page.url();
+  const again = await page.context().newPage();
+  await again.goto(link);
+  assert.equal(await again.inputValue('#smooth'), '3');
+  await again.close();
+});
+
 test('"Decimate to" shrinks both sides to the target, closed, with the frame\'s topology, and is kept in the link', async () => {
   // 3 000 is within reach of both sides at 48 cells (EMC's corners and curved rims keep about
   // 1 800 vertices' worth of triangles; below that it stops short of the target).
