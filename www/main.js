@@ -12,7 +12,7 @@ import { showReference } from './reference.js';
 const $ = (id) => document.getElementById(id);
 const DEFAULT_SCENE = 'cube_minus_sphere';
 /** Options kept in the session and the link, by input id. */
-const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth', 'decimate', 'smooth'];
+const FIELDS = ['bounds', 'res', 'theta', 'phi', 'tol', 'depth', 'decimate', 'decimate-error', 'smooth'];
 const CHECKS = ['auto-bounds', 'live', 'wireframe', 'features', 'normals', 'bad'];
 
 await init();
@@ -102,6 +102,8 @@ function options(method, bounds) {
   const common = { bounds };
   if (method !== 'quad') {
     if (target >= 1) common.decimate = Math.floor(target);
+    const bound = Number($('decimate-error').value);
+    if (target >= 1 && bound > 0) common.decimateError = bound;
     if (passes >= 1) common.smooth = passes;
   }
   if (method === 'dmc') {
@@ -260,7 +262,7 @@ for (const id of ['theta', 'phi']) {
   });
   $(`${id}-slider`).addEventListener('change', optionChanged);
 }
-for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate', 'smooth']) {
+for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate', 'decimate-error', 'smooth']) {
   $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }
 for (const id of ['theta', 'phi']) $(id).addEventListener('input', showAngles);

@@ -180,6 +180,11 @@ test('"Smooth" relaxes both sides without moving a feature line or opening the m
   const unsmoothed = await shape();
   await page.fill('#smooth', '3');
   await page.click('#run');
+  // The panes may still read as settled from the last mesh when the new request starts.
+  await page.waitForFunction(([side, old]) => {
+    const cell = (key) => document.querySelector(`${side} .stats tr[data-key="${key}"] td:last-child`)?.textContent;
+    return cell('smallest angle (°)') !== old[0] || cell('RMS distance') !== old[1];
+  }, [RIGHT, unsmoothed], { timeout: 60_000 });
   await settled(page);
   for (const side of [LEFT, RIGHT]) {
     assert.equal(await stat(page, side, 'closed manifold'), 'yes', side);
@@ -193,6 +198,37 @@ test('"Smooth" relaxes both sides without moving a feature line or opening the m
   const again = await page.context().newPage();
   await again.goto(link);
   assert.equal(await again.inputValue('#smooth'), '3');
+  await again.close();
+});
+
+test('"within … cells" bounds the decimation: a tighter bound keeps more triangles, EMC\'s max distance within it', async () => {
+  const { page } = await openDemo();
+  const res = Number(await page.inputValue('#res'));
+  const b = (await page.inputValue('#bounds')).split(' ').map(Number);
+  const cell = Math.max(b[3] - b[0], b[4] - b[1], b[5] - b[2]) / res;
+  const decimated = async (cells) => {
+    const before = await stat(page, LEFT, 'triangles');
+    await page.fill('#decimate', '1');
+    await page.fill('#decimate-error', String(cells));
+    await page.click('#run');
+    // The panes may still read as settled from the last mesh when the new request starts.
+    await page.waitForFunction(([side, old]) => document.querySelector(`${side} .stats tr[data-key="triangles"] td:last-child`)?.textContent !== old, [LEFT, before], { timeout: 60_000 });
+    await settled(page);
+    assert.equal(await stat(page, LEFT, 'closed manifold'), 'yes', `within ${cells} cells`);
+    assert.equal(await count(page, LEFT, 'crossing pairs'), 0, `within ${cells} cells`);
+    const distance = await count(page, LEFT, 'max distance');
+    // 1 % over for the f32 rounding of the mesh the numbers are taken from.
+    assert.ok(distance <= 1.01 * cells * cell, `within ${cells} cells: max distance ${distance}, cell ${cell}`);
+    return count(page, LEFT, 'triangles');
+  };
+  // EMC's own faces reach 0.11 cells from the surface at 48 cells (the teeth of docs/emc.md), and
+  // decimation leaves a face alone rather than move it: the bounds here lie above that.
+  const tight = await decimated(0.25);
+  const loose = await decimated(1);
+  assert.ok(loose < tight, `${loose} triangles within 1 cell, ${tight} within 0.25`);
+  const again = await page.context().newPage();
+  await again.goto(page.url());
+  assert.equal(await again.inputValue('#decimate-error'), '1');
   await again.close();
 });
 
