@@ -21,8 +21,9 @@ pub(super) struct Plan {
 impl State<'_> {
     /// Everything a collapse of `u` into `v` must pass (see the module doc), tried at each of
     /// `placements` for `v` in turn; the faces it rewrites and where `v` goes for the first that
-    /// passes.
-    pub(super) fn check(&mut self, u: u32, v: u32, placements: &[DVec3]) -> Option<Plan> {
+    /// passes. New angles must also exceed `angle_above` (radians; the sliver passes ask for better
+    /// than the sliver they remove).
+    pub(super) fn check(&mut self, u: u32, v: u32, placements: &[DVec3], angle_above: f64) -> Option<Plan> {
         let fan_u = self.faces_of[u as usize].clone();
         let fan_v = self.faces_of[v as usize].clone();
         let removed: Vec<u32> =
@@ -42,8 +43,7 @@ impl State<'_> {
         let line = self.line_check(u, v)?;
         let old_min =
             fan_u.iter().chain(&fan_v).map(|&f| min_angle(&self.corners(f))).fold(f64::INFINITY, f64::min);
-        let floor =
-            self.options.min_angle_deg.to_radians().min(old_min.max(self.sliver_floor.unwrap_or(0.0)));
+        let floor = self.options.min_angle_deg.to_radians().min(old_min.max(angle_above));
         let free = self.kind[u as usize] == Kind::Free && self.kind[v as usize] == Kind::Free;
         for &p in placements {
             // The cheap, purely geometric checks first: most refusals are new slivers.

@@ -197,8 +197,6 @@ struct State<'a> {
     tiny_area: f64,
     fd_step: f32,
     collapses: usize,
-    /// While slivers are collapsed (see `slivers`): new angles must exceed this one.
-    sliver_floor: Option<f64>,
 }
 
 impl<'a> State<'a> {
@@ -242,7 +240,6 @@ impl<'a> State<'a> {
             tiny_area: (1e-12 * diagonal * diagonal).powi(2),
             fd_step: (1e-4 * diagonal).max(1e-6) as f32,
             collapses: 0,
-            sliver_floor: None,
         };
         state.classify(feature_edges);
         state.init_quadrics();
@@ -495,7 +492,7 @@ impl<'a> State<'a> {
                     }
                 }
             }
-            if let Some(plan) = self.check(c.remove, c.keep, &placements) {
+            if let Some(plan) = self.check(c.remove, c.keep, &placements, 0.0) {
                 self.apply(c.remove, c.keep, plan);
                 // Faces grow as they go: buckets sized for the first ones would record each
                 // survivor in dozens of cubes and make every crossing query scan them.

@@ -51,7 +51,7 @@ impl State<'_> {
         let length = |e: &[u32; 2]| (self.pos[e[0] as usize] - self.pos[e[1] as usize]).length();
         let mut edges: Vec<[u32; 2]> = (0..3).map(|i| [t[i], t[(i + 1) % 3]]).collect();
         edges.sort_by(|a, b| length(a).total_cmp(&length(b)));
-        self.sliver_floor = Some(angle * (1.0 + 1e-4));
+        let angle_above = angle * (1.0 + 1e-4);
         let mut done = false;
         'edges: for [a, b] in edges {
             for (u, v) in [(a, b), (b, a)] {
@@ -68,14 +68,13 @@ impl State<'_> {
                 if self.kind[u as usize] == Kind::Free && self.kind[v as usize] == Kind::Free {
                     placements.push(0.5 * (pu + pv));
                 }
-                if let Some(plan) = self.check(u, v, &placements) {
+                if let Some(plan) = self.check(u, v, &placements, angle_above) {
                     self.apply(u, v, plan);
                     done = true;
                     break 'edges;
                 }
             }
         }
-        self.sliver_floor = None;
         done
     }
 
