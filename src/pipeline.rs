@@ -394,11 +394,18 @@ pub fn mesh_program(program: &Program, request: &Request) -> Result<Output, Erro
 /// Leaf bricks of the tape octree are about this many cells of the finest grid on a side.
 const CELLS_PER_BRICK: usize = 4;
 
+/// DMC's leaf bricks are smaller: it bounds every finest cell of its crust and evaluates points
+/// all through them (samples, roots, distances of candidate triangles), so a brick's tape is
+/// asked more per cell than by a grid mesher that bounds boxes of four cells. Measured on the
+/// gear at depth 6 (callgrind): 4.63 → 3.36 G instructions, the fandisk and the rocket within 2 %.
+const DMC_CELLS_PER_BRICK: usize = 2;
+
 /// [`mesh_field`] through a [`RegionalProgram`]: every query, from the crust's intervals to the
 /// analysis's distances, runs on a tape specialised to the brick it falls in.
 pub fn mesh_program_in(program: &Program, bounds: (Vec3, Vec3), request: &Request) -> Result<Output, Error> {
     let (min, max) = request.bounds.unwrap_or(bounds);
-    let depth = RegionalProgram::depth_for(request.reported_res(), CELLS_PER_BRICK);
+    let cells_per_brick = if request.method == Method::Dmc { DMC_CELLS_PER_BRICK } else { CELLS_PER_BRICK };
+    let depth = RegionalProgram::depth_for(request.reported_res(), cells_per_brick);
     let regional = RegionalProgram::new(program, min, max, depth);
     let mut output = mesh_field(&regional, bounds, request)?;
     output.stats.tape = Some(TapeStats::from(&regional.tape_lengths()));

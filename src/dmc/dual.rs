@@ -40,11 +40,21 @@ pub fn point_key(p: [u32; 3]) -> u64 {
 /// The dual cell at lattice point `p` (finest cells, inside the grid's closed box), with `merged`
 /// seen as a leaf; `None` where `p` is a corner of none of the leaves around it.
 pub fn dual_cell(tree: &Octree, p: [u32; 3], merged: u32) -> Option<[VertexKey; 8]> {
-    let mut keys = [VertexKey { node: NONE, clamp: 0 }; 8];
-    let mut corner = false;
     let below = |a: usize| p[a].saturating_sub(1);
     let above = |a: usize| p[a].min(tree.cells[a] - 1);
     let start = tree.common_ancestor([below(0), below(1), below(2)], [above(0), above(1), above(2)], merged);
+    dual_cell_by(tree, p, |q| tree.locate_from(start, q, merged))
+}
+
+/// [`dual_cell`] with the leaf holding a finest cell given by `leaf_at`: the octants around `p`,
+/// those beyond the grid's faces clamped onto them.
+pub fn dual_cell_by(
+    tree: &Octree,
+    p: [u32; 3],
+    mut leaf_at: impl FnMut([u32; 3]) -> u32,
+) -> Option<[VertexKey; 8]> {
+    let mut keys = [VertexKey { node: NONE, clamp: 0 }; 8];
+    let mut corner = false;
     for (o, key) in keys.iter_mut().enumerate() {
         let mut q = [0u32; 3];
         let mut clamp = 0u8;
@@ -63,7 +73,7 @@ pub fn dual_cell(tree: &Octree, p: [u32; 3], merged: u32) -> Option<[VertexKey; 
                 clamp |= 1 << (2 * a);
             }
         }
-        let leaf = tree.locate_from(start, q, merged);
+        let leaf = leaf_at(q);
         if !corner {
             let (lo, hi) = tree.int_box(leaf);
             corner = (0..3).all(|a| p[a] == lo[a] || p[a] == hi[a]);

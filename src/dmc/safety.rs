@@ -18,7 +18,7 @@
 //! criterion, with the guarantee of Ju et al. 2002 §4.2 (their tests are on the signs of a primal
 //! grid; DMC's signs are at the dual vertices, where theirs do not apply).
 
-use super::dual::{self, dual_cell, VertexKey};
+use super::dual::{self, dual_cell_by, VertexKey};
 use super::tree::{Kind, Octree, NONE};
 use crate::tables::{triangle_table, EDGES};
 use rustc_hash::FxHashMap as HashMap;
@@ -30,18 +30,25 @@ pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
 /// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
 pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriangle>> {
     let (lo, hi) = tree.int_box(n);
+    let around = Neighbourhood::of(tree, n);
     // The star's points before the merge: the children's corners and the neighbours' corners on
     // the node's closed box. After it, the children's corners that are neither the node's own nor
     // a neighbour's are no octree vertices any more; the others keep their dual cells, with every
     // child among their leaves replaced by the node. So each point's leaves are located once.
-    let mut points = Vec::new();
-    neighbour_corners(tree, 0, n, lo, hi, &mut points);
-    let kept = unique(points.clone());
     let first = tree.nodes[n as usize].children;
-    for c in 0..8 {
-        let child = first + c;
+    let children = first..first + 8;
+    let mut points = Vec::new();
+    for &leaf in around.leaves.iter().filter(|l| !children.contains(l)) {
+        for p in corners(tree, leaf) {
+            if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
+                points.push(p);
+            }
+        }
+    }
+    let kept = unique(points.clone());
+    for child in children.clone() {
         if tree.nodes[child as usize].kind != Kind::Absent {
-            push_corners(tree, child, &mut points);
+            points.extend(corners(tree, child));
         }
     }
     let points = unique(points);
@@ -49,11 +56,10 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
         kept.binary_search_by_key(&dual::point_key(p), |&q| dual::point_key(q)).is_ok()
             || (0..3).all(|a| p[a] == lo[a] || p[a] == hi[a])
     };
-    let children = first..first + 8;
     let mut cells_before = Vec::with_capacity(points.len());
     let mut cells_after = Vec::with_capacity(points.len());
     for &p in &points {
-        let Some(cell) = dual_cell(tree, p, NONE) else { continue };
+        let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(q)) else { continue };
         cells_before.push(cell);
         if is_kept(p) {
             cells_after.push(cell.map(|k| {
@@ -98,38 +104,72 @@ fn unique(points: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
 }
 
 /// Lattice points (as `[u32; 3]`) of the corners of leaf `n`.
-fn push_corners(tree: &Octree, n: u32, out: &mut Vec<[u32; 3]>) {
+fn corners(tree: &Octree, n: u32) -> [[u32; 3]; 8] {
     let (lo, hi) = tree.int_box(n);
-    for c in 0..8 {
-        out.push(std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] }));
-    }
+    std::array::from_fn(|c| std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] }))
 }
 
-/// Corners of leaves outside node `skip` that lie on the closed box `[lo, hi]`.
-fn neighbour_corners(tree: &Octree, n: u32, skip: u32, lo: [u32; 3], hi: [u32; 3], out: &mut Vec<[u32; 3]>) {
-    if n == skip {
-        return;
-    }
-    let (nlo, nhi) = tree.int_box(n);
-    if (0..3).any(|a| nhi[a] < lo[a] || nlo[a] > hi[a]) {
-        return;
-    }
-    let node = &tree.nodes[n as usize];
-    match node.kind {
-        Kind::Absent => {}
-        Kind::Internal => {
-            for c in 0..8 {
-                neighbour_corners(tree, node.children + c, skip, lo, hi, out);
+/// The leaves around a node: every finest cell of its box grown by one cell (clipped to the
+/// grid) mapped to the leaf holding it, from one walk down from the smallest node holding that
+/// box. The star's points are the corners of these leaves, and every leaf of the star's dual
+/// cells is one of them, so nothing is located from the root again.
+struct Neighbourhood {
+    lo: [u32; 3],
+    dims: [u32; 3],
+    /// Per finest cell of the grown box (x fastest), its leaf.
+    leaf: Vec<u32>,
+    /// The leaves meeting the grown box, children of the node included.
+    leaves: Vec<u32>,
+}
+
+impl Neighbourhood {
+    fn of(tree: &Octree, n: u32) -> Neighbourhood {
+        let (lo, hi) = tree.int_box(n);
+        let glo = lo.map(|c| c.saturating_sub(1));
+        let ghi: [u32; 3] = std::array::from_fn(|a| (hi[a] + 1).min(tree.cells[a]));
+        let dims: [u32; 3] = std::array::from_fn(|a| ghi[a] - glo[a]);
+        let mut around = Neighbourhood {
+            lo: glo,
+            dims,
+            leaf: vec![NONE; (dims[0] * dims[1] * dims[2]) as usize],
+            leaves: Vec::new(),
+        };
+        let mut stack = vec![tree.common_ancestor(glo, ghi.map(|c| c - 1), NONE)];
+        while let Some(m) = stack.pop() {
+            let (mlo, mhi) = tree.int_box(m);
+            if (0..3).any(|a| mhi[a] <= glo[a] || mlo[a] >= ghi[a]) {
+                continue;
             }
-        }
-        _ => {
-            for c in 0..8 {
-                let p: [u32; 3] = std::array::from_fn(|a| if (c >> a) & 1 == 1 { nhi[a] } else { nlo[a] });
-                if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
-                    out.push(p);
+            let node = &tree.nodes[m as usize];
+            match node.kind {
+                Kind::Absent => {}
+                Kind::Internal => stack.extend((0..8).map(|c| node.children + c)),
+                _ => {
+                    around.leaves.push(m);
+                    let (flo, fhi): ([u32; 3], [u32; 3]) = (
+                        std::array::from_fn(|a| mlo[a].max(glo[a])),
+                        std::array::from_fn(|a| mhi[a].min(ghi[a])),
+                    );
+                    for z in flo[2]..fhi[2] {
+                        for y in flo[1]..fhi[1] {
+                            let row = around.index([flo[0], y, z]);
+                            around.leaf[row..row + (fhi[0] - flo[0]) as usize].fill(m);
+                        }
+                    }
                 }
             }
         }
+        around
+    }
+
+    fn index(&self, q: [u32; 3]) -> usize {
+        let [x, y, z] = std::array::from_fn(|a| q[a] - self.lo[a]);
+        ((z * self.dims[1] + y) * self.dims[0] + x) as usize
+    }
+
+    /// The leaf holding finest cell `q` (inside the grown box).
+    fn leaf_at(&self, q: [u32; 3]) -> u32 {
+        self.leaf[self.index(q)]
     }
 }
 
