@@ -58,13 +58,14 @@ impl<'a> Fidelity<'a> {
         let mut midpoints: HashMap<(DualEdge, DualEdge), u32> = HashMap::default();
         let mut samples: Vec<[u32; 4]> = Vec::with_capacity(all.len());
         for t in &all {
-            let [a, b, c] = t.map(|e| self.crossings[&e]);
+            let corners = t.map(|e| self.crossings[&e]);
+            let [a, b, c] = corners;
             let centroid = self.points.len() as u32;
             self.points.push((a + b + c) / 3.0);
             let mut ids = [centroid; 4];
             for (k, (i, j)) in [(0, 1), (1, 2), (2, 0)].into_iter().enumerate() {
                 let key = (t[i].min(t[j]), t[i].max(t[j]));
-                let (p, q) = (self.crossings[&t[i]], self.crossings[&t[j]]);
+                let (p, q) = (corners[i], corners[j]);
                 let next = self.points.len() as u32;
                 let id = *midpoints.entry(key).or_insert(next);
                 if id == next {

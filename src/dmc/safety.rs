@@ -37,38 +37,54 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
     // child among their leaves replaced by the node. So each point's leaves are located once.
     let first = tree.nodes[n as usize].children;
     let children = first..first + 8;
-    let mut points = Vec::new();
+    // Marks on the lattice points of the closed box: a star point, and one that stays an octree
+    // vertex after the merge.
+    const POINT: u8 = 1;
+    const KEPT: u8 = 2;
+    let side: [u32; 3] = std::array::from_fn(|a| hi[a] - lo[a] + 1);
+    let index = |p: [u32; 3]| (((p[2] - lo[2]) * side[1] + p[1] - lo[1]) * side[0] + p[0] - lo[0]) as usize;
+    let mut marks = vec![0u8; (side[0] * side[1] * side[2]) as usize];
     for &leaf in around.leaves.iter().filter(|l| !children.contains(l)) {
         for p in corners(tree, leaf) {
             if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
-                points.push(p);
+                marks[index(p)] |= POINT | KEPT;
             }
         }
     }
-    let kept = unique(points.clone());
     for child in children.clone() {
         if tree.nodes[child as usize].kind != Kind::Absent {
-            points.extend(corners(tree, child));
+            for p in corners(tree, child) {
+                marks[index(p)] |= POINT;
+            }
         }
     }
-    let points = unique(points);
-    let is_kept = |p: [u32; 3]| {
-        kept.binary_search_by_key(&dual::point_key(p), |&q| dual::point_key(q)).is_ok()
-            || (0..3).all(|a| p[a] == lo[a] || p[a] == hi[a])
-    };
-    let mut cells_before = Vec::with_capacity(points.len());
-    let mut cells_after = Vec::with_capacity(points.len());
-    for &p in &points {
-        let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(q)) else { continue };
-        cells_before.push(cell);
-        if is_kept(p) {
-            cells_after.push(cell.map(|k| {
-                if children.contains(&k.node) {
-                    VertexKey { node: n, ..k }
-                } else {
-                    k
+    for c in 0..8 {
+        let p: [u32; 3] = std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] });
+        marks[index(p)] |= KEPT;
+    }
+    let mut cells_before = Vec::new();
+    let mut cells_after = Vec::new();
+    // In the order of the points' keys (z, then y, then x), which names the crossings.
+    for z in lo[2]..=hi[2] {
+        for y in lo[1]..=hi[1] {
+            for x in lo[0]..=hi[0] {
+                let p = [x, y, z];
+                let mark = marks[index(p)];
+                if mark & POINT == 0 {
+                    continue;
                 }
-            }));
+                let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(q)) else { continue };
+                cells_before.push(cell);
+                if mark & KEPT != 0 {
+                    cells_after.push(cell.map(|k| {
+                        if children.contains(&k.node) {
+                            VertexKey { node: n, ..k }
+                        } else {
+                            k
+                        }
+                    }));
+                }
+            }
         }
     }
     let sign_before = |k: VertexKey| dual::inside(tree, k);
@@ -92,15 +108,6 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
         (Some(a), Some(b)) if a == b => Some(edges(&tris_after)),
         _ => None,
     }
-}
-
-/// The points, each once (in the order of their keys).
-fn unique(points: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
-    let mut keys: Vec<u64> = points.iter().map(|&p| dual::point_key(p)).collect();
-    keys.sort_unstable();
-    keys.dedup();
-    let mask = (1u64 << 21) - 1;
-    keys.iter().map(|&k| [(k & mask) as u32, ((k >> 21) & mask) as u32, (k >> 42) as u32]).collect()
 }
 
 /// Lattice points (as `[u32; 3]`) of the corners of leaf `n`.
@@ -224,16 +231,18 @@ fn star_triangles(
 /// each bounded by one loop; `None` for anything else (a closed piece, an annulus, a handle, an
 /// edge on three triangles, two pieces meeting at a point).
 fn discs_boundary(tris: &[[u32; 3]], vertices: usize) -> Option<Vec<(u32, u32)>> {
-    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tris.len() * 3);
+    // Edges as sorted pairs packed into one integer (low end high), which sorts faster.
+    let mut edges: Vec<u64> = Vec::with_capacity(tris.len() * 3);
     for t in tris {
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
-            edges.push((a.min(b), a.max(b)));
+            edges.push((a.min(b) as u64) << 32 | a.max(b) as u64);
         }
     }
     edges.sort_unstable();
+    let ends = |e: u64| ((e >> 32) as u32, e as u32);
     // Distinct edges with their use counts.
-    let mut counted: Vec<((u32, u32), u8)> = Vec::with_capacity(edges.len());
+    let mut counted: Vec<(u64, u8)> = Vec::with_capacity(edges.len());
     for e in edges {
         match counted.last_mut() {
             Some((last, uses)) if *last == e => {
@@ -250,7 +259,7 @@ fn discs_boundary(tris: &[[u32; 3]], vertices: usize) -> Option<Vec<(u32, u32)>>
         pieces.union(t[0], t[1]);
         pieces.union(t[1], t[2]);
     }
-    let boundary: Vec<(u32, u32)> = counted.iter().filter(|(_, u)| *u == 1).map(|(e, _)| *e).collect();
+    let boundary: Vec<(u32, u32)> = counted.iter().filter(|(_, u)| *u == 1).map(|&(e, _)| ends(e)).collect();
     let mut degree = vec![0u8; vertices];
     let mut loops = UnionFind::new(vertices);
     for &(a, b) in &boundary {
@@ -269,8 +278,8 @@ fn discs_boundary(tris: &[[u32; 3]], vertices: usize) -> Option<Vec<(u32, u32)>>
             }
         }
     }
-    for ((a, _), _) in &counted {
-        euler[pieces.find(*a) as usize] -= 1;
+    for &(e, _) in &counted {
+        euler[pieces.find(ends(e).0) as usize] -= 1;
     }
     let mut loop_of = vec![u32::MAX; vertices];
     for v in 0..vertices as u32 {
