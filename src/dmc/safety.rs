@@ -29,7 +29,6 @@ pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
 /// Whether making internal node `n` (whose children are all leaves) a leaf whose vertex has value
 /// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
 pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriangle>> {
-    let (lo, hi) = tree.int_box(n);
     let around = Neighbourhood::of(tree, n);
     // The star's points before the merge: the children's corners and the neighbours' corners on
     // the node's closed box. After it, the children's corners that are neither the node's own nor
@@ -37,54 +36,19 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
     // child among their leaves replaced by the node. So each point's leaves are located once.
     let first = tree.nodes[n as usize].children;
     let children = first..first + 8;
-    // Marks on the lattice points of the closed box: a star point, and one that stays an octree
-    // vertex after the merge.
-    const POINT: u8 = 1;
-    const KEPT: u8 = 2;
-    let side: [u32; 3] = std::array::from_fn(|a| hi[a] - lo[a] + 1);
-    let index = |p: [u32; 3]| (((p[2] - lo[2]) * side[1] + p[1] - lo[1]) * side[0] + p[0] - lo[0]) as usize;
-    let mut marks = vec![0u8; (side[0] * side[1] * side[2]) as usize];
-    for &leaf in around.leaves.iter().filter(|l| !children.contains(l)) {
-        for p in corners(tree, leaf) {
-            if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
-                marks[index(p)] |= POINT | KEPT;
-            }
-        }
-    }
-    for child in children.clone() {
-        if tree.nodes[child as usize].kind != Kind::Absent {
-            for p in corners(tree, child) {
-                marks[index(p)] |= POINT;
-            }
-        }
-    }
-    for c in 0..8 {
-        let p: [u32; 3] = std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] });
-        marks[index(p)] |= KEPT;
-    }
     let mut cells_before = Vec::new();
     let mut cells_after = Vec::new();
-    // In the order of the points' keys (z, then y, then x), which names the crossings.
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                let p = [x, y, z];
-                let mark = marks[index(p)];
-                if mark & POINT == 0 {
-                    continue;
+    for (p, kept) in star_points(tree, n, &around) {
+        let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(tree, q)) else { continue };
+        cells_before.push(cell);
+        if kept {
+            cells_after.push(cell.map(|k| {
+                if children.contains(&k.node) {
+                    VertexKey { node: n, ..k }
+                } else {
+                    k
                 }
-                let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(q)) else { continue };
-                cells_before.push(cell);
-                if mark & KEPT != 0 {
-                    cells_after.push(cell.map(|k| {
-                        if children.contains(&k.node) {
-                            VertexKey { node: n, ..k }
-                        } else {
-                            k
-                        }
-                    }));
-                }
-            }
+            }));
         }
     }
     let sign_before = |k: VertexKey| dual::inside(tree, k);
@@ -110,24 +74,86 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
     }
 }
 
+/// The star's points of a merge of node `n`, each once, in the order of their keys (z, then y,
+/// then x: the order that names the crossings), with whether it stays an octree vertex after the
+/// merge (a neighbour's corner or the node's own). Marked on the lattice of the node's closed box
+/// where that is small, sorted otherwise.
+fn star_points(tree: &Octree, n: u32, around: &Neighbourhood) -> Vec<([u32; 3], bool)> {
+    const POINT: u8 = 1;
+    const KEPT: u8 = 2;
+    let (lo, hi) = tree.int_box(n);
+    let first = tree.nodes[n as usize].children;
+    let children = first..first + 8;
+    let mut marked: Vec<([u32; 3], u8)> = Vec::with_capacity(8 * around.leaves.len() + 8);
+    for &leaf in around.leaves.iter().filter(|l| !children.contains(l)) {
+        for p in corners(tree, leaf) {
+            if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
+                marked.push((p, POINT | KEPT));
+            }
+        }
+    }
+    for child in children.filter(|&c| tree.nodes[c as usize].kind != Kind::Absent) {
+        marked.extend(corners(tree, child).map(|p| (p, POINT)));
+    }
+    marked.extend(corners(tree, n).map(|p| (p, KEPT)));
+    let side: [u32; 3] = std::array::from_fn(|a| hi[a] - lo[a] + 1);
+    let lattice = side.iter().map(|&s| s as u64).product::<u64>();
+    let mut points = Vec::new();
+    if lattice <= MAPPED_CELLS as u64 {
+        let index =
+            |p: [u32; 3]| (((p[2] - lo[2]) * side[1] + p[1] - lo[1]) * side[0] + p[0] - lo[0]) as usize;
+        let mut marks = vec![0u8; lattice as usize];
+        for &(p, mark) in &marked {
+            marks[index(p)] |= mark;
+        }
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let mark = marks[index([x, y, z])];
+                    if mark & POINT != 0 {
+                        points.push(([x, y, z], mark & KEPT != 0));
+                    }
+                }
+            }
+        }
+    } else {
+        marked.sort_unstable_by_key(|&(p, _)| dual::point_key(p));
+        for same in marked.chunk_by(|a, b| a.0 == b.0) {
+            let mark = same.iter().fold(0, |m, &(_, k)| m | k);
+            if mark & POINT != 0 {
+                points.push((same[0].0, mark & KEPT != 0));
+            }
+        }
+    }
+    points
+}
+
 /// Lattice points (as `[u32; 3]`) of the corners of leaf `n`.
 fn corners(tree: &Octree, n: u32) -> [[u32; 3]; 8] {
     let (lo, hi) = tree.int_box(n);
     std::array::from_fn(|c| std::array::from_fn(|a| if (c >> a) & 1 == 1 { hi[a] } else { lo[a] }))
 }
 
-/// The leaves around a node: every finest cell of its box grown by one cell (clipped to the
-/// grid) mapped to the leaf holding it, from one walk down from the smallest node holding that
-/// box. The star's points are the corners of these leaves, and every leaf of the star's dual
-/// cells is one of them, so nothing is located from the root again.
+/// The leaves around a node: every leaf meeting its box grown by one finest cell (clipped to the
+/// grid), from one walk down from the smallest node holding that box. The star's points are the
+/// corners of these leaves, and every leaf of the star's dual cells is one of them. Where the grown
+/// box is small (merges near the finest level: nearly all of them) each of its finest cells is
+/// mapped to its leaf, so nothing is located from the root again; a larger box (near the top of a
+/// deep octree, mostly empty leaves) locates through the tree from the walk's start instead.
 struct Neighbourhood {
     lo: [u32; 3],
     dims: [u32; 3],
-    /// Per finest cell of the grown box (x fastest), its leaf.
+    /// The node the walk started from: it holds the grown box.
+    start: u32,
+    /// Per finest cell of the grown box (x fastest), its leaf; empty for a large box.
     leaf: Vec<u32>,
     /// The leaves meeting the grown box, children of the node included.
     leaves: Vec<u32>,
 }
+
+/// Grown boxes of at most this many finest cells are mapped cell by cell (a box of 30 cells on
+/// a side; the merge of eight finest cells grows to 64).
+const MAPPED_CELLS: u32 = 1 << 15;
 
 impl Neighbourhood {
     fn of(tree: &Octree, n: u32) -> Neighbourhood {
@@ -135,13 +161,17 @@ impl Neighbourhood {
         let glo = lo.map(|c| c.saturating_sub(1));
         let ghi: [u32; 3] = std::array::from_fn(|a| (hi[a] + 1).min(tree.cells[a]));
         let dims: [u32; 3] = std::array::from_fn(|a| ghi[a] - glo[a]);
+        let cells = dims.iter().map(|&d| d as u64).product::<u64>();
+        let start = tree.common_ancestor(glo, ghi.map(|c| c - 1), NONE);
+        let mapped = cells <= MAPPED_CELLS as u64;
         let mut around = Neighbourhood {
             lo: glo,
             dims,
-            leaf: vec![NONE; (dims[0] * dims[1] * dims[2]) as usize],
+            start,
+            leaf: if mapped { vec![NONE; cells as usize] } else { Vec::new() },
             leaves: Vec::new(),
         };
-        let mut stack = vec![tree.common_ancestor(glo, ghi.map(|c| c - 1), NONE)];
+        let mut stack = vec![start];
         while let Some(m) = stack.pop() {
             let (mlo, mhi) = tree.int_box(m);
             if (0..3).any(|a| mhi[a] <= glo[a] || mlo[a] >= ghi[a]) {
@@ -153,6 +183,9 @@ impl Neighbourhood {
                 Kind::Internal => stack.extend((0..8).map(|c| node.children + c)),
                 _ => {
                     around.leaves.push(m);
+                    if !mapped {
+                        continue;
+                    }
                     let (flo, fhi): ([u32; 3], [u32; 3]) = (
                         std::array::from_fn(|a| mlo[a].max(glo[a])),
                         std::array::from_fn(|a| mhi[a].min(ghi[a])),
@@ -175,8 +208,12 @@ impl Neighbourhood {
     }
 
     /// The leaf holding finest cell `q` (inside the grown box).
-    fn leaf_at(&self, q: [u32; 3]) -> u32 {
-        self.leaf[self.index(q)]
+    fn leaf_at(&self, tree: &Octree, q: [u32; 3]) -> u32 {
+        if self.leaf.is_empty() {
+            tree.locate_from(self.start, q, NONE)
+        } else {
+            self.leaf[self.index(q)]
+        }
     }
 }
 
