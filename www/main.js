@@ -262,7 +262,7 @@ for (const id of ['theta', 'phi']) {
   });
   $(`${id}-slider`).addEventListener('change', optionChanged);
 }
-for (const id of ['res', 'theta', 'phi', 'tol', 'depth', 'bounds', 'decimate', 'decimate-error', 'smooth']) {
+for (const id of FIELDS) {
   $(id).addEventListener('change', () => { syncSlider(); showAngles(); optionChanged(); });
 }
 for (const id of ['theta', 'phi']) $(id).addEventListener('input', showAngles);

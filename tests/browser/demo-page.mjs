@@ -29,6 +29,17 @@ export const stat = (page, side, key) => page.$eval(`${side} .stats tr[data-key=
 export const count = async (page, side, key) => Number((await stat(page, side, key)).replace(/,/g, ''));
 
 /**
+ * Waits until one of the numbers `keys` of a pane differs from `old` (theirs, read before a new
+ * run was asked for): the panes may still read as settled from the last mesh when the new request
+ * starts, so `settled` alone could read the old numbers.
+ */
+export async function statsChanged(page, side, keys, old) {
+  await page.waitForFunction(([side, keys, old]) => keys.some((key, i) =>
+    document.querySelector(`${side} .stats tr[data-key="${key}"] td:last-child`)?.textContent !== old[i]),
+  [side, keys, old], { timeout: 60_000 });
+}
+
+/**
  * Registers the hooks of a test file and returns `{ openDemo, server }`: `openDemo(options)` opens
  * the demo in a new page (of a new browser context unless `context` is given) and waits for
  * its first meshes; `url` overrides the address (a shared link, say).

@@ -3,7 +3,7 @@
 // on change, a phone layout, bad triangles and the language reference. Headless Chromium.
 import { test, before, after, afterEach } from 'node:test';
 import assert from 'node:assert/strict';
-import { demoSuite, settled, stat, count, LEFT, RIGHT } from './demo-page.mjs';
+import { demoSuite, settled, stat, count, statsChanged, LEFT, RIGHT } from './demo-page.mjs';
 
 const { openDemo } = demoSuite({ before, after, afterEach });
 
@@ -180,11 +180,7 @@ test('"Smooth" relaxes both sides without moving a feature line or opening the m
   const unsmoothed = await shape();
   await page.fill('#smooth', '3');
   await page.click('#run');
-  // The panes may still read as settled from the last mesh when the new request starts.
-  await page.waitForFunction(([side, old]) => {
-    const cell = (key) => document.querySelector(`${side} .stats tr[data-key="${key}"] td:last-child`)?.textContent;
-    return cell('smallest angle (°)') !== old[0] || cell('RMS distance') !== old[1];
-  }, [RIGHT, unsmoothed], { timeout: 60_000 });
+  await statsChanged(page, RIGHT, ['smallest angle (°)', 'RMS distance'], unsmoothed);
   await settled(page);
   for (const side of [LEFT, RIGHT]) {
     assert.equal(await stat(page, side, 'closed manifold'), 'yes', side);
@@ -211,8 +207,7 @@ test('"within … cells" bounds the decimation: a tighter bound keeps more trian
     await page.fill('#decimate', '1');
     await page.fill('#decimate-error', String(cells));
     await page.click('#run');
-    // The panes may still read as settled from the last mesh when the new request starts.
-    await page.waitForFunction(([side, old]) => document.querySelector(`${side} .stats tr[data-key="triangles"] td:last-child`)?.textContent !== old, [LEFT, before], { timeout: 60_000 });
+    await statsChanged(page, LEFT, ['triangles'], [before]);
     await settled(page);
     assert.equal(await stat(page, LEFT, 'closed manifold'), 'yes', `within ${cells} cells`);
     assert.equal(await count(page, LEFT, 'crossing pairs'), 0, `within ${cells} cells`);
