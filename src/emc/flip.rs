@@ -10,10 +10,16 @@
 
 use super::nearby::NearbyTriangles;
 use crate::mesh::analysis::bvh::Aabb;
-use crate::mesh::analysis::tri_tri::folded_across_edge;
+use crate::mesh::analysis::tri_tri::folded_within;
 use crate::mesh::Mesh;
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
+
+/// How close (degrees) the half-planes of two triangles across an edge may come before a flip
+/// that makes them counts as folding them onto each other. A crease EMC joins opens wider than
+/// this; a pair nearer is a fold (on the gear at 64 cells, two triangles in its top face, which
+/// lies in a grid plane, came 1.5° apart and a later merge made them cross).
+const FLIP_FOLD_DEG: f64 = 10.0;
 
 /// One pass over all edges; returns how many were flipped. `is_feature` marks the fan centres,
 /// `on_feature` those of them that lie on their feature: a flip must join two centres, at least
@@ -99,10 +105,10 @@ pub fn flip_toward_features(
         let folds_onto_neighbour = |u: u32, v: u32, w: u32| {
             directed.get(&(v, u)).is_some_and(|&n| {
                 let x = opposite(mesh.triangles[n as usize], u, v);
-                folded_across_edge(d64(v) - d64(u), d64(w) - d64(u), d64(x) - d64(u))
+                folded_within(d64(v) - d64(u), d64(w) - d64(u), d64(x) - d64(u), FLIP_FOLD_DEG)
             })
         };
-        if folded_across_edge(d64(d) - d64(c), d64(a) - d64(c), d64(b) - d64(c))
+        if folded_within(d64(d) - d64(c), d64(a) - d64(c), d64(b) - d64(c), FLIP_FOLD_DEG)
             || [(c, a, d), (a, d, c), (d, b, c), (b, c, d)]
                 .iter()
                 .any(|&(u, v, w)| folds_onto_neighbour(u, v, w))

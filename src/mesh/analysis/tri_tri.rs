@@ -93,12 +93,17 @@ pub const FOLD_DEG: f64 = 1.0;
 /// primitives only up to the QEF solve's and `f32`'s rounding: measured tilts of 1e-4° to 0.3°).
 /// Triangles thinner than 1e-3 of the edge have no reliable side and never count.
 pub fn folded_across_edge(e: DVec3, c: DVec3, d: DVec3) -> bool {
+    folded_within(e, c, d, FOLD_DEG)
+}
+
+/// [`folded_across_edge`] with the half-planes within `max_deg` of each other.
+pub fn folded_within(e: DVec3, c: DVec3, d: DVec3, max_deg: f64) -> bool {
     let (nc, nd) = (e.cross(c), e.cross(d));
     let thin = 1e-3 * e.length_squared();
     if nc.length() <= thin || nd.length() <= thin {
         return false;
     }
-    nc.dot(nd) > FOLD_DEG.to_radians().cos() * nc.length() * nd.length()
+    nc.dot(nd) > max_deg.to_radians().cos() * nc.length() * nd.length()
 }
 
 /// Normalised sines of the angles from the first side ray to `x` and from `x` to the second, both
