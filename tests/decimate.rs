@@ -319,13 +319,14 @@ fn sliver_share(mesh: &isoforge::Mesh) -> f64 {
 }
 
 /// The goal, fewer than 2 % of the triangles under 10° without moving a feature point,
-/// where EMC has 6.0 % (cube minus a ball, decimated: 0 %), 15.8 % (rotated box: 0.6 %) and
-/// 0.9 % (fandisk: 1.8 %, its fixed feature vertices keeping their slivers as the rest thins out)
-/// at 64 cells. Not the gear: its teeth's fans keep 7.7 % (docs/decimate.md).
+/// where EMC at 64 cells has 6.0 % (cube minus a ball, decimated: 0 %), 15.8 % (rotated box:
+/// 0.2 %), 0.9 % (fandisk: 0.5 %), 4.3 % (cube with cut-outs: 0.8 %) and 12.4 % (rocket: 0.5 %).
+/// Before the sliver passes moved free vertices, the fandisk kept 1.8 % and the cube with cut-outs
+/// 2.4 %. Not the gear decimated this far (see below).
 #[test]
 #[cfg_attr(target_arch = "wasm32", ignore)]
 fn decimation_to_a_tenth_leaves_few_slivers() {
-    for name in ["cube_minus_sphere", "rotated_box", "fandisk"] {
+    for name in ["cube_minus_sphere", "rotated_box", "fandisk", "cube_with_cutouts", "rocket"] {
         let res = 64;
         let input = pipeline::mesh_scene(name, &request(res)).unwrap();
         let target = input.mesh.triangle_count() / 10;
@@ -335,6 +336,32 @@ fn decimation_to_a_tenth_leaves_few_slivers() {
         assert!(after < 0.02, "{name}: {:.1} % of the triangles under 10°", 100.0 * after);
         assert_kept(&input, &output, scene_cell(name, res), name);
     }
+}
+
+/// The gear at 64 cells, whose teeth's short creases leave EMC with 6.1 % of its triangles under
+/// 10°: decimation's sliver passes alone (a target above its count: sliver edges collapsed, free
+/// vertices moved, flat pairs flipped; no feature point moves) take it under 2 % (0.6 %; 0.9 %
+/// before free vertices moved), no sample of it farther from the surface than EMC's. Decimated to
+/// a tenth it keeps 6.4 %: the slivers left there lie between vertices of its feature lines.
+#[test]
+#[cfg_attr(target_arch = "wasm32", ignore)]
+fn the_gears_slivers_go_with_decimations_sliver_passes() {
+    let res = 64;
+    let field = scenes::scene("gear").unwrap().field;
+    let input = pipeline::mesh_scene("gear", &request(res)).unwrap();
+    let everything = input.mesh.triangle_count() + 1;
+    let output =
+        pipeline::mesh_scene("gear", &Request { decimate: Some(everything), ..request(res) }).unwrap();
+    let (before, after) = (sliver_share(&input.mesh), sliver_share(&output.mesh));
+    eprintln!("gear: {:.1} % -> {:.1} % under 10°", 100.0 * before, 100.0 * after);
+    assert!(before > 0.05, "the gear's slivers are still there to remove: {before}");
+    assert!(after < 0.02, "{:.1} % of the triangles under 10°", 100.0 * after);
+    let (far_before, far_after) = (
+        largest_estimated_distance(&input.mesh, field.as_ref()),
+        largest_estimated_distance(&output.mesh, field.as_ref()),
+    );
+    assert!(far_after <= far_before * 1.01 + 1e-6, "{far_before} -> {far_after}");
+    assert_kept(&input, &output, scene_cell("gear", res), "gear");
 }
 
 /// Every triangle method's mesh can be decimated (no feature lines: only the quadrics and the

@@ -131,6 +131,7 @@ pub fn decimate(
         state.options.max_error = Some(worst);
     }
     state.collapse_slivers();
+    state.relax_slivers();
     state.improve_angles();
     Ok(state.finish(mesh))
 }

@@ -25,6 +25,12 @@ impl State<'_> {
     /// curved strips, which no flip mends (two of them make a thin rectangle, and either diagonal
     /// is as thin). How many went.
     pub(super) fn collapse_slivers(&mut self) -> usize {
+        self.sweep_slivers(|state, f, angle| state.collapse_sliver(f, angle))
+    }
+
+    /// Calls `mend` with every live face whose smallest angle is under [`SLIVER_DEG`] (and that
+    /// angle), sweeping again while one was mended, at most [`SWEEPS`] times; how many were.
+    fn sweep_slivers(&mut self, mut mend: impl FnMut(&mut Self, u32, f64) -> bool) -> usize {
         let sliver = SLIVER_DEG.to_radians();
         let mut count = 0;
         for _ in 0..SWEEPS {
@@ -32,7 +38,7 @@ impl State<'_> {
             for f in 0..self.tris.len() as u32 {
                 if self.alive[f as usize] {
                     let angle = min_angle(&self.corners(f));
-                    if angle < sliver && self.collapse_sliver(f, angle) {
+                    if angle < sliver && mend(self, f, angle) {
                         count += 1;
                     }
                 }
@@ -76,6 +82,24 @@ impl State<'_> {
             }
         }
         done
+    }
+
+    /// Moves a free vertex of each sliver towards its neighbours' centre (all the way, then half)
+    /// where every face around it ends up with a larger smallest angle than the fan's before, and
+    /// the move passes the collapse's checks: the slivers whose edges cannot collapse (a free
+    /// vertex between fixed ones, next to a crease) and whose pair is not flat enough to flip.
+    /// How many moved.
+    pub(super) fn relax_slivers(&mut self) -> usize {
+        self.sweep_slivers(|state, f, _| {
+            let free: Vec<u32> = state.tris[f as usize]
+                .into_iter()
+                .filter(|&v| state.kind[v as usize] == Kind::Free)
+                .collect();
+            free.into_iter().any(|v| {
+                let floor = state.fan_min_angle(v) * (1.0 + 1e-4);
+                state.move_toward_centre(v, floor, 1.0) || state.move_toward_centre(v, floor, 0.5)
+            })
+        })
     }
 
     /// Flips the non-feature edges of slivers where that raises the pair's smallest angle.
