@@ -29,6 +29,7 @@
 mod balance;
 mod check;
 mod quadric;
+mod queue;
 mod relax;
 mod slivers;
 
@@ -40,8 +41,8 @@ use crate::progress::checkpoint;
 use check::Plan;
 use glam::{DVec3, Vec3};
 use quadric::Quadric;
-use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
+use queue::{Candidate, Queue};
+use std::collections::HashMap;
 
 /// What to decimate to and how careful to be.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,34 +147,6 @@ const ROUND_GAIN: usize = 100;
 /// Heap entries looked at between two checkpoints.
 const POPS_PER_CHECKPOINT: usize = 4096;
 
-/// A heap entry: collapse `remove` into `keep`, moving `keep` to `target`; stale once either
-/// vertex's stamp has moved on.
-struct Candidate {
-    cost: f64,
-    remove: u32,
-    keep: u32,
-    target: DVec3,
-    stamps: [u32; 2],
-}
-
-impl PartialEq for Candidate {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Candidate {
-    /// Reversed, so the max-heap pops the cheapest collapse.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.cost.total_cmp(&self.cost)
-    }
-}
-
 struct State<'a> {
     pos: Vec<DVec3>,
     tris: Vec<[u32; 3]>,
@@ -191,7 +164,7 @@ struct State<'a> {
     grid: TriangleBuckets,
     /// The faces alive when `grid` was built.
     grid_faces: usize,
-    heap: BinaryHeap<Candidate>,
+    heap: Queue,
     field: Option<&'a dyn Field>,
     options: DecimateOptions,
     /// Below this squared length a face normal counts as degenerate.
@@ -230,7 +203,7 @@ impl<'a> State<'a> {
             line_neighbours: vec![Vec::new(); n],
             grid: TriangleBuckets::build(1.0, std::iter::empty()),
             grid_faces: 0,
-            heap: BinaryHeap::new(),
+            heap: Queue::default(),
             alive_count: alive.iter().filter(|&&a| a).count(),
             pos,
             tris,
