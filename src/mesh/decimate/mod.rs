@@ -587,17 +587,18 @@ impl<'a> State<'a> {
 
 /// Smallest interior angle of a triangle, in radians (0 for a degenerate one).
 fn min_angle(c: &[DVec3; 3]) -> f64 {
-    (0..3)
-        .map(|i| {
-            let (a, b) = (c[(i + 1) % 3] - c[i], c[(i + 2) % 3] - c[i]);
-            let s = a.length() * b.length();
-            if s > 0.0 {
-                (a.dot(b) / s).clamp(-1.0, 1.0).acos()
-            } else {
-                0.0
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
+    // One `acos`, of the largest cosine, not three: it is monotone, so the smallest angle is the
+    // same number (a degenerate corner counts as 0).
+    let mut largest = f64::NEG_INFINITY;
+    for i in 0..3 {
+        let (a, b) = (c[(i + 1) % 3] - c[i], c[(i + 2) % 3] - c[i]);
+        let s = a.length() * b.length();
+        if s.is_nan() || s <= 0.0 {
+            return 0.0;
+        }
+        largest = largest.max((a.dot(b) / s).clamp(-1.0, 1.0));
+    }
+    largest.acos()
 }
 
 /// Distance from `x` to the segment `a`–`b`.
