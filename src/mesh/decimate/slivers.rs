@@ -104,25 +104,10 @@ impl State<'_> {
 
     /// Flips the non-feature edges of slivers where that raises the pair's smallest angle.
     pub(super) fn improve_angles(&mut self) {
-        let sliver = SLIVER_DEG.to_radians();
-        for _ in 0..SWEEPS {
-            let mut flipped = false;
-            for f in 0..self.tris.len() as u32 {
-                if !self.alive[f as usize] || min_angle(&self.corners(f)) >= sliver {
-                    continue;
-                }
-                let t = self.tris[f as usize];
-                for i in 0..3 {
-                    if self.try_flip(f, t[i], t[(i + 1) % 3]) {
-                        flipped = true;
-                        break;
-                    }
-                }
-            }
-            if !flipped {
-                break;
-            }
-        }
+        self.sweep_slivers(|state, f, _| {
+            let t = state.tris[f as usize];
+            (0..3).any(|i| state.try_flip(f, t[i], t[(i + 1) % 3]))
+        });
     }
 
     /// Flips edge `a → b` of face `f1 = (a, b, c)` with its neighbour `f2 = (b, a, d)` into
