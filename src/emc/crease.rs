@@ -15,6 +15,7 @@
 //! share those crossings decide alike.
 
 use super::edges::EdgeSampler;
+use super::feature::{third_sheet, widest_pair_indices};
 use glam::Vec3;
 
 /// Halvings of the path between two crossings: the last piece is 1/32 of it (at most 0.05 cells).
@@ -54,16 +55,83 @@ pub fn smooth_at_fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSample
     })
 }
 
+/// A sharp component that looks like three sheets but has two at the fine scale: its third
+/// sheet (the normal most different from the widest pair's, sharp against both) is joined to one
+/// of the two by a smooth path, and not to the other. A rounded edge tessellated in strips, each turning under θ,
+/// meeting a flat face, is one crease: taken as a corner, the outer strips' planes and the face's
+/// meet off the surface (a fifth of a cell on the fandisk at 64 cells), and so do the tangent
+/// planes of an edge. Gives a point on the crease, found by walking from one sheet of the widest
+/// pair to the other, where that works; `None` otherwise, and where the sampler cannot walk.
+pub fn two_sheet_crease(
+    pts: &[Vec3],
+    nrm: &[Vec3],
+    sampler: &dyn EdgeSampler,
+    theta_sharp: f32,
+) -> Option<Crease> {
+    let (a, b) = widest_pair_indices(nrm)?;
+    let c = third_sheet(nrm, nrm[a], nrm[b]);
+    if nrm[c].dot(nrm[a]) >= theta_sharp || nrm[c].dot(nrm[b]) >= theta_sharp {
+        return None;
+    }
+    // Joined to exactly one: on a cone, whose normals spread like a corner's, the third joins
+    // both smoothly, and the crease the walk finds between the two is the apex.
+    let joins = [a, b].map(|s| path_is_smooth((pts[s], nrm[s]), (pts[c], nrm[c]), sampler, theta_sharp));
+    if !matches!(joins, [Some(true), Some(false)] | [Some(false), Some(true)]) {
+        return None;
+    }
+    crease_between((pts[a], nrm[a]), (pts[b], nrm[b]), sampler, theta_sharp)
+}
+
 /// Whether the surface between crossings `a` and `b` (point, unit normal) bends without a jump
 /// past `theta_sharp` at 1/32 of their distance; `None` where it cannot be walked (see
-/// [`smooth_at_fine_scale`]). Points of the chord are taken to the surface along the pair's mean
-/// normal, on a segment long enough to reach a surface bent to a radius of half the chord.
+/// [`smooth_at_fine_scale`]).
 pub fn path_is_smooth(
     a: (Vec3, Vec3),
     b: (Vec3, Vec3),
     sampler: &dyn EdgeSampler,
     theta_sharp: f32,
 ) -> Option<bool> {
+    walk(a, b, sampler, theta_sharp, true).map(|w| w.smooth)
+}
+
+/// Where the surface between crossings `a` and `b` jumps past `theta_sharp`: a point within 1/64
+/// of their distance of the crease, near the surface; `None` where the path is smooth or cannot be
+/// walked. A start for resampling a crease that the tangent planes at the crossings miss.
+pub fn crease_between(
+    a: (Vec3, Vec3),
+    b: (Vec3, Vec3),
+    sampler: &dyn EdgeSampler,
+    theta_sharp: f32,
+) -> Option<Crease> {
+    walk(a, b, sampler, theta_sharp, false).filter(|w| !w.smooth).map(|w| w.crease)
+}
+
+/// Where a walk between two crossings ended: the middle of the last piece it kept, and that
+/// piece's ends on the surface with their normals, one on each side of the crease when there is
+/// one.
+pub struct Crease {
+    pub at: Vec3,
+    pub sides: [(Vec3, Vec3); 2],
+}
+
+/// What [`walk`] found: whether the path is smooth, and where it ended.
+struct Walk {
+    smooth: bool,
+    crease: Crease,
+}
+
+/// Bisects the path between crossings `a` and `b`, keeping the half whose ends' normals differ
+/// more. Points of the chord are taken to the surface along the pair's mean normal, on a segment
+/// long enough to reach a surface bent to a radius of half the chord. `settle_early` ends the walk
+/// of a jump that has not shrunk after [`SETTLED_AFTER`] halvings (enough to call it a crease,
+/// not to say where it is).
+fn walk(
+    a: (Vec3, Vec3),
+    b: (Vec3, Vec3),
+    sampler: &dyn EdgeSampler,
+    theta_sharp: f32,
+    settle_early: bool,
+) -> Option<Walk> {
     let mean = a.1 + b.1;
     if mean.length() < MIN_MEAN {
         return None;
@@ -74,28 +142,33 @@ pub fn path_is_smooth(
     if reach == 0.0 {
         return None;
     }
-    let normal_at = |s: f32| {
+    let sample_at = |s: f32| {
         let q = a.0 + chord * s;
-        sampler.crossing_on_segment(q - mean * reach, q + mean * reach).map(|(_, n)| n)
+        let (from, to) = (q - mean * reach, q + mean * reach);
+        sampler.crossing_on_segment(from, to).map(|(t, n)| (from + (to - from) * t, n))
     };
-    let (mut s0, mut n0, mut s1, mut n1) = (0.0f32, a.1, 1.0f32, b.1);
+    let (mut s0, mut p0, mut n0, mut s1, mut p1, mut n1) = (0.0f32, a.0, a.1, 1.0f32, b.0, b.1);
     let first_jump = n0.angle_between(n1);
     for halving in 0..HALVINGS {
-        if halving == SETTLED_AFTER && n0.angle_between(n1) >= KEPT * first_jump {
-            return Some(false);
+        if settle_early && halving == SETTLED_AFTER && n0.angle_between(n1) >= KEPT * first_jump {
+            return Some(Walk {
+                smooth: false,
+                crease: Crease { at: (p0 + p1) * 0.5, sides: [(p0, n0), (p1, n1)] },
+            });
         }
         let s = 0.5 * (s0 + s1);
-        let n = normal_at(s)?;
+        let (p, n) = sample_at(s)?;
         if n == Vec3::ZERO {
             return None;
         }
         if n0.dot(n) < n.dot(n1) {
-            (s1, n1) = (s, n);
+            (s1, p1, n1) = (s, p, n);
         } else {
-            (s0, n0) = (s, n);
+            (s0, p0, n0) = (s, p, n);
         }
     }
-    Some(n0.dot(n1) >= theta_sharp)
+    let crease = Crease { at: (p0 + p1) * 0.5, sides: [(p0, n0), (p1, n1)] };
+    Some(Walk { smooth: n0.dot(n1) >= theta_sharp, crease })
 }
 
 #[cfg(test)]
@@ -144,5 +217,37 @@ mod tests {
         let sampler = crate::emc::edges::SampleInterpolation { values: &values, grid: &grid };
         let (a, b) = (on_circle(1.0, -30.0), on_circle(1.0, 30.0));
         assert!(!smooth_at_fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9));
+    }
+
+    /// A flat face meeting a rounded edge tessellated in strips 0.3 cells wide, the first at 45°
+    /// to the face and each next one 20° further: crossings on the face, the first strip and the
+    /// third look like a corner by their normals, but the first strip joins the third smoothly, and
+    /// the crease found is the one between the face and the first strip.
+    #[test]
+    fn strips_after_a_face_make_one_crease() {
+        let normal = |deg: f32| Vec3::new(deg.to_radians().sin(), deg.to_radians().cos(), 0.0);
+        let tangent = |deg: f32| Vec3::new(deg.to_radians().cos(), -deg.to_radians().sin(), 0.0);
+        let angles = [0.0f32, 45.0, 65.0, 85.0];
+        // Each strip starts where the one before ends; the face's plane passes through the origin.
+        let mut starts = vec![Vec3::ZERO];
+        for &deg in &angles[1..] {
+            starts.push(*starts.last().unwrap() + tangent(deg) * 0.3);
+        }
+        let planes: Vec<(Vec3, f32)> =
+            (0..4).map(|i| (normal(angles[i]), normal(angles[i]).dot(starts[i.max(1) - 1]))).collect();
+        let field = move |p: Vec3| planes.iter().map(|(n, d)| p.dot(*n) - d).fold(f32::MIN, f32::max);
+        let sampler = FieldRoots { field: &field, iso: 0.0, directed: true, h: 1.0 };
+        let z = Vec3::Z * 0.2;
+        let face = (Vec3::new(-0.5, 0.0, 0.0) + z, normal(0.0));
+        let first_strip = (tangent(45.0) * 0.15 + z, normal(45.0));
+        let third_strip = (starts[2] + tangent(85.0) * 0.15 + z, normal(85.0));
+        for (p, _) in [face, first_strip, third_strip] {
+            assert!(field(p).abs() < 1e-5, "{p} on the surface");
+        }
+        let (pts, nrm) = ([face.0, first_strip.0, third_strip.0], [face.1, first_strip.1, third_strip.1]);
+        let crease = two_sheet_crease(&pts, &nrm, &sampler, 0.9).expect("one crease");
+        assert!(crease.at.truncate().length() < 0.05, "crease found at {}", crease.at);
+        let [(_, n0), (_, n1)] = crease.sides;
+        assert!(n0.dot(normal(0.0)) > 0.999 && n1.dot(normal(45.0)) > 0.999, "sides {n0} {n1}");
     }
 }

@@ -61,6 +61,13 @@ pub fn widest_pair_indices(normals: &[Vec3]) -> Option<(usize, usize)> {
     widest.1
 }
 
+/// The normal most different from both `na` and `nb` (smallest larger dot product): a corner's
+/// third sheet.
+pub fn third_sheet(nrm: &[Vec3], na: Vec3, nb: Vec3) -> usize {
+    let closeness = |n: Vec3| n.dot(na).max(n.dot(nb));
+    (0..nrm.len()).min_by(|&i, &j| closeness(nrm[i]).total_cmp(&closeness(nrm[j]))).unwrap_or(0)
+}
+
 /// Direction of the feature line of an edge component: across its two most different normals.
 pub fn crease_direction(normals: &[Vec3]) -> Option<Vec3> {
     let dir = widest_pair(normals).1.normalize_or_zero();

@@ -27,6 +27,8 @@
 //! edge or vertex belong to exactly one of the triangles there (the top-left rule of rasterisers).
 //! So a ray through an edge or vertex of a closed mesh counts one crossing, never zero or two.
 
+mod probe;
+
 use super::edges::EdgeSampler;
 use super::winding::WindingTree;
 use super::{mesh_with_sampler, EmcMesh, EmcOptions, EmcTimings};
@@ -481,6 +483,24 @@ impl EdgeSampler for MeshRays<'_> {
             .nearest(a + (b - a) * t, f32::INFINITY)
             .map_or(Vec3::ZERO, |(_, tri)| self.mesh.normal(tri));
         (t, n)
+    }
+
+    /// The nearest hit on the segment, where the segment meets the mesh an odd number of times
+    /// (its ends on opposite sides of a closed mesh); `None` for an even count, which includes a
+    /// hit counted twice on a shared edge, and for a mesh with holes, whose sides are not decided
+    /// by crossings.
+    fn crossing_on_segment(&self, a: Vec3, b: Vec3) -> Option<(f32, Vec3)> {
+        if !self.directed || self.mesh.open_edges > 0 {
+            return None;
+        }
+        let hits = self.mesh.segment_hits(a, b);
+        let &(t, tri) = hits.first()?;
+        (hits.len() % 2 == 1).then(|| (t, self.mesh.normal(tri)))
+    }
+
+    /// The exact distance to the nearest triangle.
+    fn distance(&self, p: Vec3) -> Option<f32> {
+        self.directed.then(|| self.mesh.nearest(p, f32::INFINITY).map(|(d, _)| d)).flatten()
     }
 }
 

@@ -24,6 +24,7 @@ pub mod placement;
 mod plan;
 pub mod point_source;
 pub mod resample;
+mod sharp;
 pub mod untangle;
 pub mod winding;
 
@@ -436,36 +437,16 @@ fn extract_slab(
                     let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
                     let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                     let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let mut kind = classify(&nrm, options.theta_sharp, options.phi_corner);
-                    // Where the input is a function, a crease is kept only where the surface
-                    // still turns past θ next to it (see `crease`).
-                    if kind != FeatureKind::Smooth
-                        && options.resample_creases
-                        && crease::smooth_at_fine_scale(&pts, &nrm, sampler, options.theta_sharp)
-                    {
-                        kind = FeatureKind::Smooth;
-                    }
+                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
                     let mut feature = None;
                     if kind != FeatureKind::Smooth {
                         let domain = (grid.origin, grid.max());
                         let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max, domain };
-                        let near = component.grown(placement::GROWTH);
-                        let (mut kind, mut solved) = feature::sharp_point(&pts, &nrm, kind, near);
-                        if options.resample_creases {
-                            let theta = options.theta_sharp;
-                            if let Some(better) =
-                                resample::resample_component(solved, kind, &component, sampler, theta)
-                            {
-                                (kind, solved) = better;
-                            }
-                        }
-                        feature = placement::place(solved, kind, &component).map(|mut placed| {
-                            if options.resample_creases {
-                                placed.check_surface(|p| sampler.distance(p), ON_SURFACE * grid.cell_size());
-                            }
-                            (placed, kind)
-                        });
-                        out.rejected_features += feature.is_none() as usize;
+                        let sharp =
+                            sharp::solve(kind, &component, sampler, options, ON_SURFACE * grid.cell_size());
+                        out.rejected_features +=
+                            (sharp.kind != FeatureKind::Smooth && sharp.feature.is_none()) as usize;
+                        feature = sharp.feature;
                     }
                     let mut plan = Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature };
                     // An approximate centre only bends the patch towards a feature it cannot

@@ -10,7 +10,7 @@
 //! point.
 
 use super::edges::EdgeSampler;
-use super::feature::{feature_point, widest_pair_indices, FeatureKind};
+use super::feature::{feature_point, third_sheet, widest_pair_indices, FeatureKind};
 use super::placement::{Component, GROWTH};
 use crate::grid::in_box;
 use glam::Vec3;
@@ -102,12 +102,6 @@ fn sheet_normals(nrm: &[Vec3], kind: FeatureKind) -> Option<Vec<Vec3>> {
         sheets.push(nrm[third_sheet(nrm, nrm[a], nrm[b])]);
     }
     Some(sheets)
-}
-
-/// The normal most different from both `na` and `nb` (smallest larger dot product).
-fn third_sheet(nrm: &[Vec3], na: Vec3, nb: Vec3) -> usize {
-    let closeness = |n: Vec3| n.dot(na).max(n.dot(nb));
-    (0..nrm.len()).min_by(|&i, &j| closeness(nrm[i]).total_cmp(&closeness(nrm[j]))).unwrap_or(0)
 }
 
 /// The feature point of a sharp component, resampled ([`resample_feature`]), and what it is. An
