@@ -108,4 +108,45 @@ mod tests {
         assert!(bvh.segment_hits(Vec3::splat(0.2), Vec3::splat(0.8)).is_empty());
         assert!(bvh.segment_hits(Vec3::new(2.0, 0.5, -0.5), Vec3::new(0.5, 2.0, -0.1)).is_empty());
     }
+
+    /// Seeded: on soups of triangles, a third of them lying in axis planes (a CAD part's faces,
+    /// whose boxes are flat), the BVH walk finds for every segment the very hits a test of every
+    /// triangle finds.
+    #[test]
+    fn segment_hits_are_those_of_every_triangle() {
+        use crate::expr::testutil::Rng;
+        let mut flat_hits = 0;
+        for seed in 0..20u64 {
+            let mut rng = Rng::new(seed);
+            let mut positions = Vec::new();
+            for _ in 0..150 {
+                let corner = rng.vec3(-1.0, 1.0);
+                let mut tri = [corner, corner + rng.vec3(-0.4, 0.4), corner + rng.vec3(-0.4, 0.4)];
+                if rng.below(3) == 0 {
+                    let axis = rng.below(3);
+                    let level = (rng.range(-1.0, 1.0) * 8.0).round() / 8.0;
+                    tri.iter_mut().for_each(|p| p[axis] = level);
+                }
+                positions.extend(tri);
+            }
+            let triangles = (0..150u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+            let bvh = MeshBvh::new(&Mesh { positions, triangles, ..Mesh::default() }).unwrap();
+            for _ in 0..300 {
+                let (a, b) = (rng.vec3(-1.5, 1.5), rng.vec3(-1.5, 1.5));
+                let (from, dir) = (a.as_dvec3(), (b - a).as_dvec3());
+                let every: Vec<u32> = (0..bvh.triangles.len() as u32)
+                    .filter(|&t| super::segment_triangle(from, dir, &bvh.triangles[t as usize]).is_some())
+                    .collect();
+                let mut walked: Vec<u32> = bvh.segment_hits(a, b).iter().map(|h| h.1).collect();
+                walked.sort();
+                assert_eq!(walked, every, "seed {seed}: segment {a} -> {b}");
+                flat_hits += every.iter().filter(|&&t| flat(&bvh.triangles[t as usize])).count();
+            }
+        }
+        assert!(flat_hits > 500, "only {flat_hits} hits on flat triangles: the case is not tested");
+    }
+
+    fn flat(tri: &[Vec3; 3]) -> bool {
+        (0..3).any(|axis| tri[0][axis] == tri[1][axis] && tri[1][axis] == tri[2][axis])
+    }
 }
