@@ -34,8 +34,8 @@ pub fn solve(
     let (pts, nrm) = (component.pts, component.nrm);
     let theta = options.theta_sharp;
     let walk = options.resample_creases;
-    // Where the input is a function, a crease is kept only where the surface still turns past θ
-    // next to it (see `crease`).
+    // Where the input can be walked (a function, a closed mesh), a crease is kept only where the
+    // surface still turns past θ next to it (see `crease`).
     if kind != FeatureKind::Smooth && walk && crease::smooth_at_fine_scale(pts, nrm, sampler, theta) {
         kind = FeatureKind::Smooth;
     }
