@@ -11,6 +11,7 @@
 //! directed distances for its remeshing (§5.3) and reconstruction (§5.2) applications.
 
 pub mod crease;
+mod crossings;
 pub mod directed;
 pub mod edges;
 pub mod feature;
@@ -31,14 +32,12 @@ pub mod winding;
 use crate::error::Error;
 use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
-use crate::mc::{joined_faces, ms_since, EdgeCache, Topology, MIN_EDGE_FRACTION, NONE};
+use crate::mc::{ms_since, EdgeCache, Topology, NONE};
 use crate::mcq::PolygonRules;
 use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
-use crate::tables::{
-    polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
-    CellTriangles, CORNERS, EDGES, EDGE_AXIS,
-};
+use crate::tables::CORNERS;
+use crossings::{cell_case, CellTables, Cells};
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, FeatureKind};
 use glam::{DVec3, Vec3};
@@ -258,23 +257,6 @@ pub fn mesh_with_sampler(
     Ok((out, timings))
 }
 
-/// Where the surface crosses cell edge `e` and its unit normal there, from `sampler`.
-fn crossing(
-    grid: &Grid,
-    sampler: &dyn EdgeSampler,
-    cell: [usize; 3],
-    e: usize,
-    d: &[f32; 8],
-) -> (Vec3, Vec3) {
-    let [a, b] = EDGES[e];
-    let ca = CORNERS[a as usize];
-    let pa = grid.position(cell[0] + ca[0], cell[1] + ca[1], cell[2] + ca[2]);
-    let mut step = Vec3::ZERO;
-    step[EDGE_AXIS[e]] = grid.spacing[EDGE_AXIS[e]];
-    let (t, n) = sampler.crossing(pa, pa + step, d[a as usize], d[b as usize]);
-    (pa + step * t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION), n)
-}
-
 /// The grid's cells in slabs of cell layers, four per thread at a time between checkpoints
 /// ([`crate::par`]; slabs through a part's detail take several times as long as others, and
 /// with one slab per thread each step waited for the slowest: extraction of the gear at 256
@@ -382,17 +364,15 @@ fn extract_slab(
     let [cx, cy, _] = grid.cells;
     let mut out = EmcMesh::default();
     let mut cache = EdgeCache::new(nx, ny);
-    let (fixed, fixed_tris) = (polygon_table(), triangle_table());
-    let (with_faces, with_faces_tris): (&[CellPolygons], &[CellTriangles]) = match options.topology {
-        Topology::Trilinear => (polygon_table_with_faces(), triangle_table_with_faces()),
-        Topology::Fixed => (&[], &[]),
-    };
+    let tables = CellTables::new(options.topology);
     let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
+    let cells = Cells { values, grid, iso: options.iso, tables: &tables, corner_offsets: &corner_offsets };
     let mut normals_of_vertex: Vec<Vec3> = Vec::new();
     let mut outside_fans: Vec<OutsideFan> = Vec::new();
     let mut centres = FanCentres::default();
 
     let first = layers.start;
+    let crossings = cells.crossings(sampler, layers.clone());
     for k in layers {
         if k > first {
             cache.advance();
@@ -400,18 +380,11 @@ fn extract_slab(
         for j in 0..cy {
             for i in 0..cx {
                 let base = grid.index(i, j, k);
-                let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - options.iso);
-                let case = d.iter().enumerate().fold(0u8, |acc, (c, &v)| acc | ((v < 0.0) as u8) << c);
+                let (d, case) = cell_case(values, base, &corner_offsets, options.iso);
                 if case == 0 || case == 255 {
                     continue;
                 }
-                let (polygons, triangles): (&CellPolygons, &CellTriangles) = match options.topology {
-                    Topology::Fixed => (&fixed[case as usize], &fixed_tris[case as usize]),
-                    Topology::Trilinear => {
-                        let key = (case as usize) << 6 | joined_faces(case, &d) as usize;
-                        (&with_faces[key], &with_faces_tris[key])
-                    }
-                };
+                let (polygons, triangles) = tables.lookup(case, &d);
                 let mut first_triangle = 0;
                 let cell_min = grid.position(i, j, k);
                 let cell_max = cell_min + grid.spacing;
@@ -425,7 +398,7 @@ fn extract_slab(
                     for &e in poly {
                         let slot = cache.slot(i, j, e as usize);
                         if *slot == NONE {
-                            let (p, n) = crossing(grid, sampler, [i, j, k], e as usize, &d);
+                            let (p, n) = crossings.get(grid, [i, j, k], e as usize);
                             *slot = out.mesh.positions.len() as u32;
                             out.mesh.positions.push(p);
                             normals_of_vertex.push(n);
