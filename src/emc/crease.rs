@@ -15,7 +15,7 @@
 //! share those crossings decide alike.
 
 use super::edges::EdgeSampler;
-use super::feature::{third_sheet, widest_pair_indices};
+use super::feature::sharp_third_sheet;
 use glam::Vec3;
 
 /// Halvings of the path between two crossings: the last piece is 1/32 of it (at most 0.05 cells).
@@ -68,11 +68,7 @@ pub fn two_sheet_crease(
     sampler: &dyn EdgeSampler,
     theta_sharp: f32,
 ) -> Option<Crease> {
-    let (a, b) = widest_pair_indices(nrm)?;
-    let c = third_sheet(nrm, nrm[a], nrm[b]);
-    if nrm[c].dot(nrm[a]) >= theta_sharp || nrm[c].dot(nrm[b]) >= theta_sharp {
-        return None;
-    }
+    let [a, b, c] = sharp_third_sheet(nrm, theta_sharp)?;
     // Joined to exactly one: on a cone, whose normals spread like a corner's, the third joins
     // both smoothly, and the crease the walk finds between the two is the apex.
     let joins = [a, b].map(|s| path_is_smooth((pts[s], nrm[s]), (pts[c], nrm[c]), sampler, theta_sharp));
@@ -145,16 +141,15 @@ fn walk(
     let sample_at = |s: f32| {
         let q = a.0 + chord * s;
         let (from, to) = (q - mean * reach, q + mean * reach);
-        sampler.crossing_on_segment(from, to).map(|(t, n)| (from + (to - from) * t, n))
+        sampler.crossing_point_on_segment(from, to)
     };
     let (mut s0, mut p0, mut n0, mut s1, mut p1, mut n1) = (0.0f32, a.0, a.1, 1.0f32, b.0, b.1);
     let first_jump = n0.angle_between(n1);
+    let mut settled = false;
     for halving in 0..HALVINGS {
         if settle_early && halving == SETTLED_AFTER && n0.angle_between(n1) >= KEPT * first_jump {
-            return Some(Walk {
-                smooth: false,
-                crease: Crease { at: (p0 + p1) * 0.5, sides: [(p0, n0), (p1, n1)] },
-            });
+            settled = true;
+            break;
         }
         let s = 0.5 * (s0 + s1);
         let (p, n) = sample_at(s)?;
@@ -168,7 +163,7 @@ fn walk(
         }
     }
     let crease = Crease { at: (p0 + p1) * 0.5, sides: [(p0, n0), (p1, n1)] };
-    Some(Walk { smooth: n0.dot(n1) >= theta_sharp, crease })
+    Some(Walk { smooth: !settled && n0.dot(n1) >= theta_sharp, crease })
 }
 
 #[cfg(test)]

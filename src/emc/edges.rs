@@ -28,6 +28,11 @@ pub trait EdgeSampler: Sync {
         None
     }
 
+    /// [`EdgeSampler::crossing_on_segment`] as a point and the unit normal there.
+    fn crossing_point_on_segment(&self, a: Vec3, b: Vec3) -> Option<(Vec3, Vec3)> {
+        self.crossing_on_segment(a, b).map(|(t, n)| (a + (b - a) * t, n))
+    }
+
     /// An estimate of the distance from any point `p` to the surface (first order, |f| / |∇f|);
     /// `None` where the sampler cannot evaluate off its records. Checks that a feature point lies
     /// on the surface.

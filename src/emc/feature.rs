@@ -68,6 +68,15 @@ pub fn third_sheet(nrm: &[Vec3], na: Vec3, nb: Vec3) -> usize {
     (0..nrm.len()).min_by(|&i, &j| closeness(nrm[i]).total_cmp(&closeness(nrm[j]))).unwrap_or(0)
 }
 
+/// The widest pair of a component's normals and a third sheet sharp (below `theta_sharp`)
+/// against both of them, as indices `[a, b, third]`; `None` where every normal is near one of
+/// the pair (a plain edge).
+pub fn sharp_third_sheet(nrm: &[Vec3], theta_sharp: f32) -> Option<[usize; 3]> {
+    let (a, b) = widest_pair_indices(nrm)?;
+    let c = third_sheet(nrm, nrm[a], nrm[b]);
+    (nrm[c].dot(nrm[a]) < theta_sharp && nrm[c].dot(nrm[b]) < theta_sharp).then_some([a, b, c])
+}
+
 /// Direction of the feature line of an edge component: across its two most different normals.
 pub fn crease_direction(normals: &[Vec3]) -> Option<Vec3> {
     let dir = widest_pair(normals).1.normalize_or_zero();

@@ -10,7 +10,7 @@
 //! point.
 
 use super::edges::EdgeSampler;
-use super::feature::{feature_point, third_sheet, widest_pair_indices, FeatureKind};
+use super::feature::{feature_point, sharp_third_sheet, third_sheet, widest_pair_indices, FeatureKind};
 use super::placement::{Component, GROWTH};
 use crate::grid::in_box;
 use glam::Vec3;
@@ -122,9 +122,7 @@ pub fn resample_component(
     let cell = (component.cell_max - component.cell_min).min_element();
     let near = component.grown(GROWTH);
     if kind == FeatureKind::Edge {
-        let (a, b) = widest_pair_indices(nrm)?;
-        let third = nrm[third_sheet(nrm, nrm[a], nrm[b])];
-        if third.dot(nrm[a]) < theta_sharp && third.dot(nrm[b]) < theta_sharp {
+        if sharp_third_sheet(nrm, theta_sharp).is_some() {
             let guess = feature_point(pts, nrm, FeatureKind::Corner);
             let corner = resample_feature(guess, FeatureKind::Corner, pts, nrm, sampler, cell)
                 .filter(|&c| in_box(c, near));
@@ -141,8 +139,7 @@ pub fn resample_component(
 fn sheet_sample(sampler: &dyn EdgeSampler, p: Vec3, normal: Vec3, cell: f32) -> Option<(Vec3, Vec3)> {
     REACHES.iter().find_map(|reach| {
         let (from, to) = (p - normal * reach * cell, p + normal * reach * cell);
-        let (t, n) = sampler.crossing_on_segment(from, to)?;
-        Some((from + (to - from) * t, n))
+        sampler.crossing_point_on_segment(from, to)
     })
 }
 

@@ -14,6 +14,7 @@ use super::feature::{self, FeatureKind};
 use super::placement::{self, Component, Placed};
 use super::resample;
 use super::EmcOptions;
+use glam::Vec3;
 
 /// What a sharp component comes to: its kind (smooth at the fine scale, or an edge where the
 /// normals suggested a corner) and its placed feature point, `None` where no valid one was found.
@@ -55,13 +56,8 @@ pub fn solve(
             (solved_kind, solved) = better;
         }
     }
-    let feature = placement::place(solved, solved_kind, component).map(|mut placed| {
-        if walk {
-            placed.check_surface(|p| sampler.distance(p), on_surface);
-        }
-        (placed, solved_kind)
-    });
-    Sharp { kind, feature }
+    let surface = walk.then_some((sampler, on_surface));
+    Sharp { kind, feature: place(solved, solved_kind, component, surface) }
 }
 
 /// An edge point on `crease`, resampled from its two sides, placed in the component's cell.
@@ -80,7 +76,20 @@ fn place_on_crease(
     let start = if planes.distance(crease.at) <= p0.distance(p1) { planes } else { crease.at };
     let point =
         resample::resample_feature(start, FeatureKind::Edge, &pts, &nrm, sampler, cell).unwrap_or(start);
-    let mut placed = placement::place(point, FeatureKind::Edge, component)?;
-    placed.check_surface(|p| sampler.distance(p), on_surface);
-    Some((placed, FeatureKind::Edge))
+    place(point, FeatureKind::Edge, component, Some((sampler, on_surface)))
+}
+
+/// `point` placed in the component's cell ([`placement::place`]), and where `surface` is given,
+/// checked to lie within its distance of the sampler's surface ([`Placed::check_surface`]).
+fn place(
+    point: Vec3,
+    kind: FeatureKind,
+    component: &Component,
+    surface: Option<(&dyn EdgeSampler, f32)>,
+) -> Option<(Placed, FeatureKind)> {
+    let mut placed = placement::place(point, kind, component)?;
+    if let Some((sampler, on_surface)) = surface {
+        placed.check_surface(|p| sampler.distance(p), on_surface);
+    }
+    Some((placed, kind))
 }
