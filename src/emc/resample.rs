@@ -121,14 +121,12 @@ pub fn resample_component(
     let (pts, nrm) = (component.pts, component.nrm);
     let cell = (component.cell_max - component.cell_min).min_element();
     let near = component.grown(GROWTH);
-    if kind == FeatureKind::Edge {
-        if sharp_third_sheet(nrm, theta_sharp).is_some() {
-            let guess = feature_point(pts, nrm, FeatureKind::Corner);
-            let corner = resample_feature(guess, FeatureKind::Corner, pts, nrm, sampler, cell)
-                .filter(|&c| in_box(c, near));
-            if let Some(corner) = corner {
-                return Some((FeatureKind::Corner, corner));
-            }
+    if kind == FeatureKind::Edge && sharp_third_sheet(nrm, theta_sharp).is_some() {
+        let guess = feature_point(pts, nrm, FeatureKind::Corner);
+        let corner = resample_feature(guess, FeatureKind::Corner, pts, nrm, sampler, cell)
+            .filter(|&c| in_box(c, near));
+        if let Some(corner) = corner {
+            return Some((FeatureKind::Corner, corner));
         }
     }
     resample_feature(solved, kind, pts, nrm, sampler, cell).map(|p| (kind, p))
