@@ -29,14 +29,7 @@ pub fn sample_crust(field: &dyn Field, grid: &Grid, iso: f32) -> Option<Result<C
     field.interval(grid.origin, grid.origin + grid.spacing)?;
     let traversal = Traversal { field, grid, iso };
     let (boxes, interval_queries) = traversal.boxes([0, 0, 0], grid.cells);
-    let mut samples =
-        Samples { grid, values: vec![f32::NAN; grid.point_count()], marked: vec![false; grid.point_count()] };
-    for b in boxes {
-        match b {
-            Decided::Fill { lo, hi, value } => samples.fill(lo, hi, value),
-            Decided::Surface { lo, hi } => samples.mark(lo, hi),
-        }
-    }
+    let samples = Samples::from_boxes(grid, &boxes);
     Some(samples.finish(field, interval_queries))
 }
 
@@ -123,30 +116,43 @@ struct Samples<'a> {
     marked: Vec<bool>,
 }
 
-impl Samples<'_> {
-    /// Gives every point of the closed box a value of the known sign (evaluated points keep theirs).
-    fn fill(&mut self, lo: [usize; 3], hi: [usize; 3], value: f32) {
-        for k in lo[2]..=hi[2] {
-            for j in lo[1]..=hi[1] {
-                for i in lo[0]..=hi[0] {
-                    let n = self.grid.index(i, j, k);
-                    if self.values[n].is_nan() {
-                        self.values[n] = value;
-                    }
-                }
-            }
-        }
-    }
+/// Point layers per piece when the boxes are applied on several threads: each piece goes over
+/// every box, so pieces are not cut finer than this.
+const APPLY_LAYERS: usize = 8;
 
-    fn mark(&mut self, lo: [usize; 3], hi: [usize; 3]) {
-        for k in lo[2]..=hi[2] {
-            for j in lo[1]..=hi[1] {
-                for i in lo[0]..=hi[0] {
-                    let n = self.grid.index(i, j, k);
-                    self.marked[n] = true;
+impl Samples<'_> {
+    /// Every point given its stand-in value by the first `Fill` box that holds it (boxes are
+    /// closed and share faces, the traversal's order decides) and marked where a `Surface` box
+    /// holds it. Pieces of point layers go to threads ([`crate::par`]); each applies the boxes in
+    /// order to its own layers, which is what one pass over the grid gives (at 256 cells a serial
+    /// pass over the 17 million points was a tenth of the gear's sampling).
+    fn from_boxes<'a>(grid: &'a Grid, boxes: &[Decided]) -> Samples<'a> {
+        let [nx, ny, _] = grid.points();
+        let layer = nx * ny;
+        let piece = APPLY_LAYERS * layer;
+        let mut values = vec![f32::NAN; grid.point_count()];
+        crate::par::map_chunks_mut(&mut values, piece, |c, values| {
+            let first = c * APPLY_LAYERS;
+            for b in boxes {
+                if let Decided::Fill { lo, hi, value } = *b {
+                    for_points(grid, lo, hi, first, values.len() / layer, |n| {
+                        if values[n].is_nan() {
+                            values[n] = value;
+                        }
+                    });
                 }
             }
-        }
+        });
+        let mut marked = vec![false; grid.point_count()];
+        crate::par::map_chunks_mut(&mut marked, piece, |c, marked| {
+            let first = c * APPLY_LAYERS;
+            for b in boxes {
+                if let Decided::Surface { lo, hi } = *b {
+                    for_points(grid, lo, hi, first, marked.len() / layer, |n| marked[n] = true);
+                }
+            }
+        });
+        Samples { grid, values, marked }
     }
 
     /// Evaluates the marked points tile by tile ([`crate::field::sample_tiles`]; they overwrite
@@ -156,6 +162,26 @@ impl Samples<'_> {
         let evaluated = crate::field::sample_tiles(field, self.grid, |n| marked[n], &mut self.values)?;
         crate::field::check_finite(&self.values, self.grid)?;
         Ok(CrustSamples { values: self.values, evaluated, interval_queries })
+    }
+}
+
+/// Calls `f` with the index, counted from point layer `first`, of every point of the closed box
+/// `lo..=hi` (point indices) that lies in the `layers` point layers from `first`.
+fn for_points(
+    grid: &Grid,
+    lo: [usize; 3],
+    hi: [usize; 3],
+    first: usize,
+    layers: usize,
+    mut f: impl FnMut(usize),
+) {
+    let start = grid.index(0, 0, first);
+    for k in lo[2].max(first)..=hi[2].min(first + layers - 1) {
+        for j in lo[1]..=hi[1] {
+            for i in lo[0]..=hi[0] {
+                f(grid.index(i, j, k) - start);
+            }
+        }
     }
 }
 

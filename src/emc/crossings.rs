@@ -18,7 +18,8 @@ use crate::tables::{
     CellTriangles, CORNERS, EDGES, EDGE_AXIS,
 };
 use glam::Vec3;
-use std::collections::hash_map::{Entry, HashMap};
+use rustc_hash::FxHashMap as HashMap;
+use std::collections::hash_map::Entry;
 
 /// The MC tables of a topology: one cell's polygons and their triangles from its corner values.
 pub(super) struct CellTables {
@@ -103,44 +104,78 @@ impl SlabCrossings {
     }
 }
 
+/// A cell the surface crosses: its x and y index in its layer, corner values minus the
+/// iso-level and MC case.
+#[derive(Clone, Copy)]
+pub(super) struct ActiveCell {
+    pub i: usize,
+    pub j: usize,
+    pub d: [f32; 8],
+    pub case: u8,
+}
+
+/// The cells of a slab that the surface crosses, layer by layer, in the sweep's order.
+pub(super) struct ActiveCells {
+    first_layer: usize,
+    cells: Vec<ActiveCell>,
+    /// `cells[layer_starts[l]..layer_starts[l + 1]]` are in layer `first_layer + l`.
+    layer_starts: Vec<usize>,
+}
+
+impl ActiveCells {
+    pub(super) fn layer(&self, k: usize) -> &[ActiveCell] {
+        let l = k - self.first_layer;
+        &self.cells[self.layer_starts[l]..self.layer_starts[l + 1]]
+    }
+}
+
 impl Cells<'_> {
-    /// The crossings of every edge of the polygons of cell layers `layers` (z indices): a slab
-    /// of a part's crust has a few dozen crossings per tape brick, enough for the columns to pay
-    /// (a layer at a time has one or two, and gained nothing on the gear).
-    pub(super) fn crossings(
-        &self,
-        sampler: &dyn EdgeSampler,
-        layers: std::ops::Range<usize>,
-    ) -> SlabCrossings {
+    /// The cells of layers `layers` (z indices) that the surface crosses: the one scan of the
+    /// slab's cells, which at 256 cells costs as much as finding the crossings.
+    pub(super) fn active(&self, layers: std::ops::Range<usize>) -> ActiveCells {
         let [cx, cy, _] = self.grid.cells;
-        let mut index = HashMap::new();
-        let mut starts = Vec::new();
-        let mut edges = Vec::new();
-        for k in layers {
+        let mut cells = Vec::new();
+        let mut layer_starts = vec![0];
+        for k in layers.clone() {
             for j in 0..cy {
                 for i in 0..cx {
-                    let base = self.grid.index(i, j, k);
-                    let (d, case) = cell_case(self.values, base, self.corner_offsets, self.iso);
-                    if case == 0 || case == 255 {
+                    let (d, case) =
+                        cell_case(self.values, self.grid.index(i, j, k), self.corner_offsets, self.iso);
+                    if case != 0 && case != 255 {
+                        cells.push(ActiveCell { i, j, d, case });
+                    }
+                }
+            }
+            layer_starts.push(cells.len());
+        }
+        ActiveCells { first_layer: layers.start, cells, layer_starts }
+    }
+
+    /// The crossings of every edge of the polygons of `slab`'s cells: a slab of a part's crust
+    /// has a few dozen crossings per tape brick, enough for the columns to pay (a layer at a time
+    /// has one or two, and gained nothing on the gear).
+    pub(super) fn crossings(&self, sampler: &dyn EdgeSampler, slab: &ActiveCells) -> SlabCrossings {
+        let mut index = HashMap::default();
+        let mut starts = Vec::new();
+        let mut edges = Vec::new();
+        for (l, pair) in slab.layer_starts.windows(2).enumerate() {
+            let k = slab.first_layer + l;
+            for &ActiveCell { i, j, d, case } in &slab.cells[pair[0]..pair[1]] {
+                let (polygons, _) = self.tables.lookup(case, &d);
+                for &e in polygons.iter().flatten() {
+                    let Entry::Vacant(slot) = index.entry(edge_key(self.grid, [i, j, k], e as usize)) else {
                         continue;
-                    }
-                    let (polygons, _) = self.tables.lookup(case, &d);
-                    for &e in polygons.iter().flatten() {
-                        let Entry::Vacant(slot) = index.entry(edge_key(self.grid, [i, j, k], e as usize))
-                        else {
-                            continue;
-                        };
-                        slot.insert(edges.len());
-                        let (start, step) = edge_start_and_step(self.grid, [i, j, k], e as usize);
-                        let [a, b] = EDGES[e as usize];
-                        edges.push(CrossedEdge {
-                            a: start,
-                            b: start + step,
-                            da: d[a as usize],
-                            db: d[b as usize],
-                        });
-                        starts.push((start, step));
-                    }
+                    };
+                    slot.insert(edges.len());
+                    let (start, step) = edge_start_and_step(self.grid, [i, j, k], e as usize);
+                    let [a, b] = EDGES[e as usize];
+                    edges.push(CrossedEdge {
+                        a: start,
+                        b: start + step,
+                        da: d[a as usize],
+                        db: d[b as usize],
+                    });
+                    starts.push((start, step));
                 }
             }
         }

@@ -37,7 +37,7 @@ use crate::mcq::PolygonRules;
 use crate::mesh::analysis::tri_tri::triangles_intersect;
 use crate::mesh::Mesh;
 use crate::tables::CORNERS;
-use crossings::{cell_case, CellTables, Cells};
+use crossings::{ActiveCell, CellTables, Cells};
 use edges::{EdgeSampler, FieldRoots, SampleInterpolation};
 use feature::{classify, FeatureKind};
 use glam::{DVec3, Vec3};
@@ -361,7 +361,6 @@ fn extract_slab(
     layers: std::ops::Range<usize>,
 ) -> Slab {
     let [nx, ny, _] = grid.points();
-    let [cx, cy, _] = grid.cells;
     let mut out = EmcMesh::default();
     let mut cache = EdgeCache::new(nx, ny);
     let tables = CellTables::new(options.topology);
@@ -372,140 +371,135 @@ fn extract_slab(
     let mut centres = FanCentres::default();
 
     let first = layers.start;
-    let crossings = cells.crossings(sampler, layers.clone());
+    let slab_cells = cells.active(layers.clone());
+    let crossings = cells.crossings(sampler, &slab_cells);
     for k in layers {
         if k > first {
             cache.advance();
         }
-        for j in 0..cy {
-            for i in 0..cx {
-                let base = grid.index(i, j, k);
-                let (d, case) = cell_case(values, base, &corner_offsets, options.iso);
-                if case == 0 || case == 255 {
-                    continue;
+        for cell in slab_cells.layer(k) {
+            let ActiveCell { i, j, d, case } = *cell;
+            let (polygons, triangles) = tables.lookup(case, &d);
+            let mut first_triangle = 0;
+            let cell_min = grid.position(i, j, k);
+            let cell_max = cell_min + grid.spacing;
+            // Pass 1: the polygons' vertices, and for each a feature point where it is sharp.
+            let mut plans: Vec<Plan> = Vec::with_capacity(4);
+            for (p, poly) in polygons.iter().enumerate() {
+                let count = triangles.per_polygon[p] as usize;
+                let group = first_triangle..first_triangle + count;
+                first_triangle += count;
+                let mut by_edge = [NONE; 13];
+                for &e in poly {
+                    let slot = cache.slot(i, j, e as usize);
+                    if *slot == NONE {
+                        let (p, n) = crossings.get(grid, [i, j, k], e as usize);
+                        *slot = out.mesh.positions.len() as u32;
+                        out.mesh.positions.push(p);
+                        normals_of_vertex.push(n);
+                        out.feature_vertex.push(false);
+                        centres.push(false, false, Vec3::ZERO);
+                    }
+                    by_edge[e as usize] = *slot;
                 }
-                let (polygons, triangles) = tables.lookup(case, &d);
-                let mut first_triangle = 0;
-                let cell_min = grid.position(i, j, k);
-                let cell_max = cell_min + grid.spacing;
-                // Pass 1: the polygons' vertices, and for each a feature point where it is sharp.
-                let mut plans: Vec<Plan> = Vec::with_capacity(4);
-                for (p, poly) in polygons.iter().enumerate() {
-                    let count = triangles.per_polygon[p] as usize;
-                    let group = first_triangle..first_triangle + count;
-                    first_triangle += count;
-                    let mut by_edge = [NONE; 13];
-                    for &e in poly {
-                        let slot = cache.slot(i, j, e as usize);
-                        if *slot == NONE {
-                            let (p, n) = crossings.get(grid, [i, j, k], e as usize);
-                            *slot = out.mesh.positions.len() as u32;
-                            out.mesh.positions.push(p);
-                            normals_of_vertex.push(n);
-                            out.feature_vertex.push(false);
-                            centres.push(false, false, Vec3::ZERO);
+                let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
+                let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
+                let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
+                let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
+                let mut feature = None;
+                if kind != FeatureKind::Smooth {
+                    let domain = (grid.origin, grid.max());
+                    let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max, domain };
+                    let sharp =
+                        sharp::solve(kind, &component, sampler, options, ON_SURFACE * grid.cell_size());
+                    out.rejected_features +=
+                        (sharp.kind != FeatureKind::Smooth && sharp.feature.is_none()) as usize;
+                    feature = sharp.feature;
+                }
+                let mut plan = Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature };
+                // An approximate centre only bends the patch towards a feature it cannot
+                // reach; where it ends up farther from the surface than MC's own triangles
+                // of the polygon, MC's are kept.
+                if options.resample_creases
+                    && plan.approximate_centre_is_worse_than_mc(
+                        &out.mesh.positions,
+                        triangles,
+                        options.better_triangles.as_ref(),
+                        |p| sampler.distance(p),
+                        WORSE_THAN_MC * grid.cell_size(),
+                    )
+                {
+                    plan.feature = None;
+                    out.rejected_features += 1;
+                }
+                plans.push(plan);
+            }
+            // Pass 2: where a cell holds several components (sheets close together), their
+            // fans must not cross one another or the others' MC triangles. Each centre stays
+            // inside the cell (an outside one takes its inside placement: it could not be
+            // pulled back later without being decided again), and fans are taken one at a
+            // time, each only if it crosses none of the other components' triangles as they
+            // stand (MC's, or a fan taken before it). MC's triangles do not cross, and every
+            // fan taken keeps it so: the cell is decided once, without a repair afterwards.
+            if plans.len() > 1 {
+                let rules = options.better_triangles.as_ref();
+                let positions = &out.mesh.positions;
+                let mut current: Vec<Vec<[DVec3; 3]>> =
+                    plans.iter().map(|p| p.plain_triangles(positions, triangles, rules)).collect();
+                for a in 0..plans.len() {
+                    if let Some((placed, _)) = &mut plans[a].feature {
+                        if let Some(inside) = placed.inside.take() {
+                            placed.at = inside;
                         }
-                        by_edge[e as usize] = *slot;
                     }
-                    let ids: Vec<u32> = poly.iter().map(|&e| by_edge[e as usize]).collect();
-                    let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
-                    let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
-                    let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
-                    let mut feature = None;
-                    if kind != FeatureKind::Smooth {
-                        let domain = (grid.origin, grid.max());
-                        let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max, domain };
-                        let sharp =
-                            sharp::solve(kind, &component, sampler, options, ON_SURFACE * grid.cell_size());
-                        out.rejected_features +=
-                            (sharp.kind != FeatureKind::Smooth && sharp.feature.is_none()) as usize;
-                        feature = sharp.feature;
-                    }
-                    let mut plan = Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature };
-                    // An approximate centre only bends the patch towards a feature it cannot
-                    // reach; where it ends up farther from the surface than MC's own triangles
-                    // of the polygon, MC's are kept.
-                    if options.resample_creases
-                        && plan.approximate_centre_is_worse_than_mc(
-                            &out.mesh.positions,
-                            triangles,
-                            options.better_triangles.as_ref(),
-                            |p| sampler.distance(p),
-                            WORSE_THAN_MC * grid.cell_size(),
-                        )
-                    {
-                        plan.feature = None;
+                    let Some(fan) = plans[a].fan_triangles() else { continue };
+                    let cuts = (0..plans.len())
+                        .filter(|&b| b != a)
+                        .any(|b| fan.iter().any(|t| current[b].iter().any(|u| triangles_intersect(t, u))));
+                    if cuts {
+                        plans[a].feature = None;
                         out.rejected_features += 1;
-                    }
-                    plans.push(plan);
-                }
-                // Pass 2: where a cell holds several components (sheets close together), their
-                // fans must not cross one another or the others' MC triangles. Each centre stays
-                // inside the cell (an outside one takes its inside placement: it could not be
-                // pulled back later without being decided again), and fans are taken one at a
-                // time, each only if it crosses none of the other components' triangles as they
-                // stand (MC's, or a fan taken before it). MC's triangles do not cross, and every
-                // fan taken keeps it so: the cell is decided once, without a repair afterwards.
-                if plans.len() > 1 {
-                    let rules = options.better_triangles.as_ref();
-                    let positions = &out.mesh.positions;
-                    let mut current: Vec<Vec<[DVec3; 3]>> =
-                        plans.iter().map(|p| p.plain_triangles(positions, triangles, rules)).collect();
-                    for a in 0..plans.len() {
-                        if let Some((placed, _)) = &mut plans[a].feature {
-                            if let Some(inside) = placed.inside.take() {
-                                placed.at = inside;
-                            }
-                        }
-                        let Some(fan) = plans[a].fan_triangles() else { continue };
-                        let cuts = (0..plans.len()).filter(|&b| b != a).any(|b| {
-                            fan.iter().any(|t| current[b].iter().any(|u| triangles_intersect(t, u)))
-                        });
-                        if cuts {
-                            plans[a].feature = None;
-                            out.rejected_features += 1;
-                        } else {
-                            current[a] = fan;
-                        }
+                    } else {
+                        current[a] = fan;
                     }
                 }
-                // Pass 3: emit.
-                for plan in plans {
-                    let Some((Placed { at: f, inside }, kind)) = plan.feature else {
-                        let (tris, extra) =
-                            plan.plain(&out.mesh.positions, triangles, options.better_triangles.as_ref());
-                        let extra_id = out.mesh.positions.len() as u32;
-                        if let Some(c) = extra {
-                            out.mesh.positions.push(c);
-                            normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
-                            out.feature_vertex.push(false);
-                            centres.push(false, false, Vec3::ZERO);
-                        }
-                        let id = |v: u32| if v == EXTRA { extra_id } else { v };
-                        out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
-                        continue;
-                    };
-                    let fid = out.mesh.positions.len() as u32;
-                    if let Some(inside) = inside {
-                        outside_fans.push(OutsideFan { vertex: fid, cell: [i, j, k], kind, inside });
+            }
+            // Pass 3: emit.
+            for plan in plans {
+                let Some((Placed { at: f, inside }, kind)) = plan.feature else {
+                    let (tris, extra) =
+                        plan.plain(&out.mesh.positions, triangles, options.better_triangles.as_ref());
+                    let extra_id = out.mesh.positions.len() as u32;
+                    if let Some(c) = extra {
+                        out.mesh.positions.push(c);
+                        normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
+                        out.feature_vertex.push(false);
+                        centres.push(false, false, Vec3::ZERO);
                     }
-                    out.mesh.positions.push(f.position);
-                    normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
-                    out.feature_vertex.push(f.is_feature_vertex());
-                    let crease = match kind {
-                        FeatureKind::Edge => feature::crease_direction(&plan.nrm).unwrap_or(Vec3::ZERO),
-                        _ => Vec3::ZERO,
-                    };
-                    centres.push(true, f.on_feature, crease);
-                    match (f.is_feature_vertex(), kind) {
-                        (false, _) => out.approximate_features += 1,
-                        (true, FeatureKind::Corner) => out.corner_features += 1,
-                        (true, _) => out.edge_features += 1,
-                    }
-                    let ids = &plan.ids;
-                    for q in 0..ids.len() {
-                        out.mesh.triangles.push([fid, ids[q], ids[(q + 1) % ids.len()]]);
-                    }
+                    let id = |v: u32| if v == EXTRA { extra_id } else { v };
+                    out.mesh.triangles.extend(tris.into_iter().map(|t| t.map(id)));
+                    continue;
+                };
+                let fid = out.mesh.positions.len() as u32;
+                if let Some(inside) = inside {
+                    outside_fans.push(OutsideFan { vertex: fid, cell: [i, j, k], kind, inside });
+                }
+                out.mesh.positions.push(f.position);
+                normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
+                out.feature_vertex.push(f.is_feature_vertex());
+                let crease = match kind {
+                    FeatureKind::Edge => feature::crease_direction(&plan.nrm).unwrap_or(Vec3::ZERO),
+                    _ => Vec3::ZERO,
+                };
+                centres.push(true, f.on_feature, crease);
+                match (f.is_feature_vertex(), kind) {
+                    (false, _) => out.approximate_features += 1,
+                    (true, FeatureKind::Corner) => out.corner_features += 1,
+                    (true, _) => out.edge_features += 1,
+                }
+                let ids = &plan.ids;
+                for q in 0..ids.len() {
+                    out.mesh.triangles.push([fid, ids[q], ids[(q + 1) % ids.len()]]);
                 }
             }
         }

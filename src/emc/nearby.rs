@@ -19,6 +19,9 @@ use crate::mesh::buckets::{bounds, TriangleBuckets};
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
 
+/// Triangles per piece of [`NearbyTriangles::around`]'s scan on several threads.
+const SCAN_PIECE: usize = 16_384;
+
 /// A mesh's triangles by where they are, for crossing tests.
 pub struct NearbyTriangles {
     buckets: TriangleBuckets,
@@ -44,11 +47,19 @@ impl NearbyTriangles {
     pub fn around(mesh: &Mesh, spacing: Vec3, region: &[Aabb]) -> NearbyTriangles {
         let cell = spacing.max_element() as f64;
         let region = Region::new(cell, region);
-        let boxes = (0..mesh.triangles.len()).map(|t| {
-            let (lo, hi) = bounds(&corners64(&mesh.corners(t)));
-            region.overlaps(lo, hi).then_some((lo, hi))
+        // The scan over every triangle is most of the cost, and each triangle's answer is its
+        // own: pieces of the list go to threads ([`crate::par`]) and are joined in order.
+        let mut boxes = vec![None; mesh.triangles.len()];
+        crate::par::map_chunks_mut(&mut boxes, SCAN_PIECE, |c, piece| {
+            for (k, b) in piece.iter_mut().enumerate() {
+                let (lo, hi) = bounds(&corners64(&mesh.corners(c * SCAN_PIECE + k)));
+                *b = region.overlaps(lo, hi).then_some((lo, hi));
+            }
         });
-        NearbyTriangles { buckets: TriangleBuckets::build_some(cell, boxes), region: Some(region) }
+        NearbyTriangles {
+            buckets: TriangleBuckets::build_some(cell, boxes.into_iter()),
+            region: Some(region),
+        }
     }
 
     /// Records triangle `t` with these corners (in place of those it had).
