@@ -27,9 +27,11 @@ impl Domain for f32 {
     fn constant(c: f32) -> f32 {
         c
     }
+    #[inline(always)]
     fn unary(op: UnaryOp, a: f32) -> f32 {
         ops::unary(op, a)
     }
+    #[inline(always)]
     fn binary(op: BinaryOp, a: f32, b: f32) -> f32 {
         ops::binary(op, a, b)
     }
@@ -50,11 +52,11 @@ pub fn run<D: Domain>(tape: &Tape, inputs: [D; 3], mut observe: impl FnMut(Binar
         }
         for instr in &tape.instrs {
             match *instr {
-                Instr::Unary { op, out, a } => slots[out as usize] = D::unary(op, slots[a as usize]),
+                Instr::Unary { op, out, a } => slots[out as usize] = unary_by_op(op, slots[a as usize]),
                 Instr::Binary { op, out, a, b } => {
                     let (x, y) = (slots[a as usize], slots[b as usize]);
                     observe(op, x, y);
-                    slots[out as usize] = D::binary(op, x, y);
+                    slots[out as usize] = binary_by_op(op, x, y);
                 }
             }
         }
@@ -68,9 +70,48 @@ pub fn run<D: Domain>(tape: &Tape, inputs: [D; 3], mut observe: impl FnMut(Binar
     }
 }
 
+/// `D::binary(op, x, y)` with one arm per operation, each calling it with its operation as a
+/// constant: with `D::binary` and [`ops::binary`] inlined into every arm, each arm is that
+/// operation's code alone, and a point's run takes one jump per instruction instead of one per
+/// `match` on the operation it passes through (the value's, then the derivative's).
+#[inline(always)]
+fn binary_by_op<D: Domain>(op: BinaryOp, x: D, y: D) -> D {
+    match op {
+        BinaryOp::Add => D::binary(BinaryOp::Add, x, y),
+        BinaryOp::Sub => D::binary(BinaryOp::Sub, x, y),
+        BinaryOp::Mul => D::binary(BinaryOp::Mul, x, y),
+        BinaryOp::Div => D::binary(BinaryOp::Div, x, y),
+        BinaryOp::Min => D::binary(BinaryOp::Min, x, y),
+        BinaryOp::Max => D::binary(BinaryOp::Max, x, y),
+        BinaryOp::Pow => D::binary(BinaryOp::Pow, x, y),
+        BinaryOp::Atan2 => D::binary(BinaryOp::Atan2, x, y),
+    }
+}
+
+/// [`binary_by_op`] for unary operations.
+#[inline(always)]
+fn unary_by_op<D: Domain>(op: UnaryOp, x: D) -> D {
+    match op {
+        UnaryOp::Neg => D::unary(UnaryOp::Neg, x),
+        UnaryOp::Abs => D::unary(UnaryOp::Abs, x),
+        UnaryOp::Sqrt => D::unary(UnaryOp::Sqrt, x),
+        UnaryOp::Sin => D::unary(UnaryOp::Sin, x),
+        UnaryOp::Cos => D::unary(UnaryOp::Cos, x),
+        UnaryOp::Tan => D::unary(UnaryOp::Tan, x),
+        UnaryOp::Asin => D::unary(UnaryOp::Asin, x),
+        UnaryOp::Acos => D::unary(UnaryOp::Acos, x),
+        UnaryOp::Atan => D::unary(UnaryOp::Atan, x),
+        UnaryOp::Exp => D::unary(UnaryOp::Exp, x),
+        UnaryOp::Ln => D::unary(UnaryOp::Ln, x),
+        UnaryOp::Floor => D::unary(UnaryOp::Floor, x),
+        UnaryOp::Sign => D::unary(UnaryOp::Sign, x),
+        UnaryOp::Powi(n) => D::unary(UnaryOp::Powi(n), x),
+    }
+}
+
 /// The derivative of unary `op` at `x`, where its value is `v`: every dual evaluator (points and
 /// columns) scales the gradient by this one, so they agree bit for bit.
-#[inline]
+#[inline(always)]
 pub(super) fn unary_slope(op: UnaryOp, x: f32, v: f32) -> f32 {
     match op {
         UnaryOp::Neg => -1.0,
@@ -124,11 +165,13 @@ impl Domain for Dual {
         Dual { v: c, d: Vec3A::ZERO }
     }
 
+    #[inline(always)]
     fn unary(op: UnaryOp, a: Dual) -> Dual {
         let v = ops::unary(op, a.v);
         Dual { v, d: a.d * unary_slope(op, a.v, v) }
     }
 
+    #[inline(always)]
     fn binary(op: BinaryOp, a: Dual, b: Dual) -> Dual {
         let v = ops::binary(op, a.v, b.v);
         let d = match op {

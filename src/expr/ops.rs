@@ -44,6 +44,7 @@ pub enum BinaryOp {
 /// Exponents up to this size become [`UnaryOp::Powi`]; larger ones stay `powf`.
 pub const MAX_POWI: i32 = 64;
 
+#[inline(always)]
 pub fn unary(op: UnaryOp, a: f32) -> f32 {
     match op {
         UnaryOp::Neg => -a,
@@ -63,6 +64,7 @@ pub fn unary(op: UnaryOp, a: f32) -> f32 {
     }
 }
 
+#[inline(always)]
 pub fn binary(op: BinaryOp, a: f32, b: f32) -> f32 {
     match op {
         BinaryOp::Add => a + b,
