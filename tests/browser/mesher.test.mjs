@@ -122,9 +122,11 @@ test('not isolated: a short cancelled call is left to finish, a long one loses i
     const shortError = await short.then(() => 'resolved', (e) => e.name);
     await mesher.meshScene('torus', { res: 16 });
     const afterShort = globalThis.workersMade;
-    // Long: still running 250 ms after its cancel, so a fresh worker takes the next call.
-    const long = mesher.meshExpr(balls, { method: 'emc', res: 256 });
-    await new Promise((r) => setTimeout(r, 1000));
+    // Long: still running 250 ms after its cancel, so a fresh worker takes the next call. It
+    // takes seconds (48 balls at 320 cells, about 1 s natively), cancelled 300 ms in: at 256 cells
+    // cancelled 1 s in, a faster build finished inside the 250 ms and kept its worker.
+    const long = mesher.meshExpr(balls, { method: 'emc', res: 320 });
+    await new Promise((r) => setTimeout(r, 300));
     const t = performance.now();
     mesher.cancel();
     const longError = await long.then(() => 'resolved', (e) => e.name);
