@@ -127,31 +127,26 @@ impl Samples<'_> {
     /// order to its own layers, which is what one pass over the grid gives (at 256 cells a serial
     /// pass over the 17 million points was a tenth of the gear's sampling).
     fn from_boxes<'a>(grid: &'a Grid, boxes: &[Decided]) -> Samples<'a> {
-        let [nx, ny, _] = grid.points();
-        let layer = nx * ny;
-        let piece = APPLY_LAYERS * layer;
-        let mut values = vec![f32::NAN; grid.point_count()];
-        crate::par::map_chunks_mut(&mut values, piece, |c, values| {
-            let first = c * APPLY_LAYERS;
-            for b in boxes {
-                if let Decided::Fill { lo, hi, value } = *b {
-                    for_points(grid, lo, hi, first, values.len() / layer, |n| {
-                        if values[n].is_nan() {
-                            values[n] = value;
-                        }
-                    });
-                }
+        let fills: Vec<_> = boxes
+            .iter()
+            .filter_map(|b| match *b {
+                Decided::Fill { lo, hi, value } => Some((lo, hi, value)),
+                Decided::Surface { .. } => None,
+            })
+            .collect();
+        let surfaces: Vec<_> = boxes
+            .iter()
+            .filter_map(|b| match *b {
+                Decided::Surface { lo, hi } => Some((lo, hi, ())),
+                Decided::Fill { .. } => None,
+            })
+            .collect();
+        let values = paint_boxes(grid, &fills, f32::NAN, |value, v| {
+            if v.is_nan() {
+                *v = value;
             }
         });
-        let mut marked = vec![false; grid.point_count()];
-        crate::par::map_chunks_mut(&mut marked, piece, |c, marked| {
-            let first = c * APPLY_LAYERS;
-            for b in boxes {
-                if let Decided::Surface { lo, hi } = *b {
-                    for_points(grid, lo, hi, first, marked.len() / layer, |n| marked[n] = true);
-                }
-            }
-        });
+        let marked = paint_boxes(grid, &surfaces, false, |(), m| *m = true);
         Samples { grid, values, marked }
     }
 
@@ -163,6 +158,27 @@ impl Samples<'_> {
         crate::field::check_finite(&self.values, self.grid)?;
         Ok(CrustSamples { values: self.values, evaluated, interval_queries })
     }
+}
+
+/// One entry per grid point, starting at `blank`, with `paint(payload, entry)` called for every
+/// box `(lo, hi, payload)` in order on the entry of every point the closed box `lo..=hi` (point
+/// indices) holds, in pieces of point layers on the threads.
+fn paint_boxes<T: Copy + Send + Sync, P: Copy + Sync>(
+    grid: &Grid,
+    boxes: &[([usize; 3], [usize; 3], P)],
+    blank: T,
+    paint: impl Fn(P, &mut T) + Sync,
+) -> Vec<T> {
+    let [nx, ny, _] = grid.points();
+    let layer = nx * ny;
+    let mut entries = vec![blank; grid.point_count()];
+    crate::par::map_chunks_mut(&mut entries, APPLY_LAYERS * layer, |c, entries| {
+        let first = c * APPLY_LAYERS;
+        for &(lo, hi, payload) in boxes {
+            for_points(grid, lo, hi, first, entries.len() / layer, |n| paint(payload, &mut entries[n]));
+        }
+    });
+    entries
 }
 
 /// Calls `f` with the index, counted from point layer `first`, of every point of the closed box

@@ -13,54 +13,11 @@
 
 use super::edges::{CrossedEdge, EdgeSampler};
 use crate::grid::Grid;
-use crate::mc::{joined_faces, Topology, MIN_EDGE_FRACTION};
-use crate::tables::{
-    polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, CellPolygons,
-    CellTriangles, CORNERS, EDGES, EDGE_AXIS,
-};
+use crate::mc::{CellTables, CrossedCells, MIN_EDGE_FRACTION};
+use crate::tables::{CORNERS, EDGES, EDGE_AXIS};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
 use std::collections::hash_map::Entry;
-
-/// The MC tables of a topology: one cell's polygons and their triangles from its corner values.
-pub(super) struct CellTables {
-    polygons: &'static [CellPolygons],
-    triangles: &'static [CellTriangles],
-    topology: Topology,
-}
-
-impl CellTables {
-    pub(super) fn new(topology: Topology) -> CellTables {
-        match topology {
-            Topology::Fixed => {
-                CellTables { polygons: polygon_table(), triangles: triangle_table(), topology }
-            }
-            Topology::Trilinear => CellTables {
-                polygons: polygon_table_with_faces(),
-                triangles: triangle_table_with_faces(),
-                topology,
-            },
-        }
-    }
-
-    /// The polygons and triangles of a cell of MC case `case` with corner values `d` (minus the
-    /// iso-level); the trilinear topology also looks at which faces join their inside corners.
-    pub(super) fn lookup(&self, case: u8, d: &[f32; 8]) -> (&CellPolygons, &CellTriangles) {
-        let key = match self.topology {
-            Topology::Fixed => case as usize,
-            Topology::Trilinear => (case as usize) << 6 | joined_faces(case, d) as usize,
-        };
-        (&self.polygons[key], &self.triangles[key])
-    }
-}
-
-/// A cell's corner values minus the iso-level and its MC case (bit `c` set where corner `c` is
-/// inside).
-fn cell_case(values: &[f32], base: usize, corner_offsets: &[usize; 8], iso: f32) -> ([f32; 8], u8) {
-    let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - iso);
-    let case = d.iter().enumerate().fold(0u8, |acc, (c, &v)| acc | ((v < 0.0) as u8) << c);
-    (d, case)
-}
 
 /// The start of cell edge `e` of `cell` and the step along it to its other end.
 fn edge_start_and_step(grid: &Grid, cell: [usize; 3], e: usize) -> (Vec3, Vec3) {
@@ -82,7 +39,6 @@ pub(super) struct Cells<'a> {
     pub grid: &'a Grid,
     pub iso: f32,
     pub tables: &'a CellTables,
-    pub corner_offsets: &'a [usize; 8],
 }
 
 /// The crossings of a slab's polygon edges, found in one batch.
@@ -126,22 +82,13 @@ impl ActiveCells {
 }
 
 impl Cells<'_> {
-    /// The cells of layers `layers` (z indices) that the surface crosses: the one scan of the
-    /// slab's cells, which at 256 cells costs as much as finding the crossings.
+    /// The cells of layers `layers` (z indices) that the surface crosses.
     pub(super) fn active(&self, layers: std::ops::Range<usize>) -> ActiveCells {
-        let [cx, cy, _] = self.grid.cells;
         let mut cells = Vec::new();
         let mut layer_starts = vec![0];
-        for k in layers.clone() {
-            for j in 0..cy {
-                for i in 0..cx {
-                    let (d, case) =
-                        cell_case(self.values, self.grid.index(i, j, k), self.corner_offsets, self.iso);
-                    if case != 0 && case != 255 {
-                        cells.push(ActiveCell { i, j, d, case });
-                    }
-                }
-            }
+        let mut scan = CrossedCells::from_layer(self.values, self.grid, self.iso, layers.start);
+        for _ in layers.clone() {
+            scan.next_layer(|[i, j, _], case, &d| cells.push(ActiveCell { i, j, d, case }));
             layer_starts.push(cells.len());
         }
         ActiveCells { first_layer: layers.start, cells, layer_starts }
@@ -150,7 +97,7 @@ impl Cells<'_> {
     /// The crossings of every edge of the polygons of `slab`'s cells, in one batch.
     pub(super) fn crossings(&self, sampler: &dyn EdgeSampler, slab: &ActiveCells) -> SlabCrossings {
         let mut index = HashMap::default();
-        let mut starts = Vec::new();
+        let mut steps = Vec::new();
         let mut edges = Vec::new();
         for (l, pair) in slab.layer_starts.windows(2).enumerate() {
             let k = slab.first_layer + l;
@@ -169,14 +116,15 @@ impl Cells<'_> {
                         da: d[a as usize],
                         db: d[b as usize],
                     });
-                    starts.push((start, step));
+                    steps.push(step);
                 }
             }
         }
-        let found = starts
+        let found = edges
             .iter()
+            .zip(&steps)
             .zip(sampler.crossings(&edges))
-            .map(|(&(start, step), (t, normal))| (point_on_edge(start, step, t), normal))
+            .map(|((edge, &step), (t, normal))| (point_on_edge(edge.a, step, t), normal))
             .collect();
         SlabCrossings { index, found }
     }

@@ -18,7 +18,7 @@ pub trait EdgeSampler: Sync {
     /// [`EdgeSampler::crossing`] on each of `edges`, the same answer edge for edge; samplers that
     /// answer faster in batches (compiled programs) override it.
     fn crossings(&self, edges: &[CrossedEdge]) -> Vec<(f32, Vec3)> {
-        edges.iter().map(|e| self.crossing(e.a, e.b, e.da, e.db)).collect()
+        crossings_one_by_one(self, edges)
     }
 
     /// The crossing on any segment `a → b` (not only a grid edge) whose ends lie on opposite sides,
@@ -39,6 +39,11 @@ pub trait EdgeSampler: Sync {
     fn distance(&self, _p: Vec3) -> Option<f32> {
         None
     }
+}
+
+/// [`EdgeSampler::crossing`] on each of `edges` in turn.
+fn crossings_one_by_one(sampler: &(impl EdgeSampler + ?Sized), edges: &[CrossedEdge]) -> Vec<(f32, Vec3)> {
+    edges.iter().map(|e| sampler.crossing(e.a, e.b, e.da, e.db)).collect()
 }
 
 /// Crossings of a field: exact by root finding (`directed`), or interpolated from the end values;
@@ -63,7 +68,7 @@ impl EdgeSampler for FieldRoots<'_> {
 
     fn crossings(&self, edges: &[CrossedEdge]) -> Vec<(f32, Vec3)> {
         if !self.directed {
-            return edges.iter().map(|e| self.crossing(e.a, e.b, e.da, e.db)).collect();
+            return crossings_one_by_one(self, edges);
         }
         let found = roots_and_gradients(self.field, self.iso, edges);
         edges.iter().zip(found).map(|(e, (t, gradient))| (t, self.normal(e.a, e.b, t, gradient))).collect()

@@ -13,14 +13,14 @@ use crate::field::{check_finite, sample_grid, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use crate::mesh::Mesh;
-use crate::tables::{
-    polygon_table, polygon_table_with_faces, triangle_table, triangle_table_with_faces, triangulate_polygon,
-    CellTriangles, CENTER, CORNERS, EDGES, EDGE_AXIS, FACES,
-};
+use crate::tables::{triangulate_polygon, CellPolygons, CENTER, CORNERS, EDGES, EDGE_AXIS, FACES};
 use glam::{DVec3, Vec3};
 use web_time::Instant;
 
+mod cells;
 pub mod interior;
+
+pub(crate) use cells::{CellTables, CrossedCells};
 
 /// Smallest distance, as a fraction of the edge, between a vertex and the edge's end points.
 pub const MIN_EDGE_FRACTION: f32 = 1e-3;
@@ -304,30 +304,20 @@ fn join_slabs(slabs: Vec<Slab>) -> Mesh {
 fn extract_slab(values: &[f32], grid: &Grid, options: &McOptions, layers: std::ops::Range<usize>) -> Slab {
     let iso = options.iso;
     let mut mesh = Mesh::default();
-    let fixed = triangle_table();
-    // The 16 384-entry table is built only when the trilinear option asks for it.
-    let with_faces: &[CellTriangles] =
-        if options.topology == Topology::Trilinear { triangle_table_with_faces() } else { &[] };
+    let tables = CellTables::new(options.topology);
     let cache = for_each_crossed_cell_in(values, grid, iso, layers, |ijk, case, d, cache| {
         let mut cell = Cell { grid, ijk, d, ids: [NONE; 13] };
-        let tris: &CellTriangles = match options.topology {
-            Topology::Fixed => &fixed[case as usize],
-            Topology::Trilinear => {
-                let joined = joined_faces(case, d);
-                let joins = interior::interior_joins(case, joined, d);
-                if !joins.is_empty() && !tunnels_meet(values, grid, iso, ijk, case) {
-                    cell.emit_with_tunnels(case, joined, &joins, cache, &mut mesh);
-                    return;
-                }
-                &with_faces[(case as usize) << 6 | joined as usize]
+        let mut joined = 0;
+        if options.topology == Topology::Trilinear {
+            joined = joined_faces(case, d);
+            let joins = interior::interior_joins(case, joined, d);
+            if !joins.is_empty() && !tunnels_meet(values, grid, iso, ijk, case) {
+                let (polygons, _) = tables.lookup_joined(case, joined);
+                cell.emit_with_tunnels(case, joined, polygons, &joins, cache, &mut mesh);
+                return;
             }
-        };
-        let polygons = match options.topology {
-            Topology::Fixed => &polygon_table()[case as usize],
-            Topology::Trilinear => {
-                &polygon_table_with_faces()[(case as usize) << 6 | joined_faces(case, d) as usize]
-            }
-        };
+        }
+        let (polygons, tris) = tables.lookup_joined(case, joined);
         let mut at = 0;
         for (poly, &count) in polygons.iter().zip(&tris.per_polygon) {
             let group = &tris.edges[3 * at..3 * (at + count as usize)];
@@ -362,103 +352,16 @@ fn for_each_crossed_cell_in(
     mut visit: impl FnMut([usize; 3], u8, &[f32; 8], &mut EdgeCache),
 ) -> EdgeCache {
     let [nx, ny, _] = grid.points();
-    let [cx, cy, _] = grid.cells;
     let mut cache = EdgeCache::new(nx, ny);
-    let corner_offsets: [usize; 8] = CORNERS.map(|[a, b, c]| a + nx * (b + ny * c));
     let first = layers.start;
-    let mut below = LayerSigns::new(grid);
-    let mut above = LayerSigns::new(grid);
-    below.read(values, grid, iso, first);
+    let mut cells = CrossedCells::from_layer(values, grid, iso, first);
     for k in layers {
         if k > first {
             cache.advance();
-            std::mem::swap(&mut below, &mut above);
         }
-        above.read(values, grid, iso, k + 1);
-        for j in 0..cy {
-            below.for_each_mixed_cell(&above, j, cx, |i| {
-                let base = grid.index(i, j, k);
-                let d: [f32; 8] = std::array::from_fn(|c| values[base + corner_offsets[c]] - iso);
-                let mut case = 0u8;
-                for (c, &v) in d.iter().enumerate() {
-                    case |= ((v < 0.0) as u8) << c;
-                }
-                visit([i, j, k], case, &d, &mut cache);
-            });
-        }
+        cells.next_layer(|ijk, case, d| visit(ijk, case, d, &mut cache));
     }
     cache
-}
-
-/// Bit `b` set where `values[b] - iso < 0`, for up to 64 values. The comparisons go to a byte
-/// each, which vectorises, and each 8 bytes of 0/1 become 8 bits in one multiplication: byte `i`
-/// times the constant's byte `7 - i` (2^i) lands in bit `56 + i` and nothing else reaches the top
-/// byte.
-fn inside_bits(values: &[f32], iso: f32) -> u64 {
-    let mut flags = [0u8; 64];
-    for (flag, &v) in flags.iter_mut().zip(values) {
-        *flag = ((v - iso) < 0.0) as u8;
-    }
-    flags.chunks_exact(8).enumerate().fold(0, |word, (group, bytes)| {
-        let bytes = u64::from_le_bytes(bytes.try_into().expect("eight bytes"));
-        word | (bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * group)
-    })
-}
-
-/// Which points of one point layer are inside (`value - iso < 0`, the test that sets a cell's
-/// case bits), one bit per point, rows of `words` 64-bit words. Most cells of a grid are far from
-/// the level; with the signs as bits a row of 64 cells is found empty in a few word operations,
-/// and only the cells the level crosses read their eight values.
-struct LayerSigns {
-    words: usize,
-    bits: Vec<u64>,
-}
-
-impl LayerSigns {
-    fn new(grid: &Grid) -> Self {
-        let [nx, ny, _] = grid.points();
-        let words = nx.div_ceil(64);
-        LayerSigns { words, bits: vec![0; words * ny] }
-    }
-
-    /// Reads point layer `k`.
-    fn read(&mut self, values: &[f32], grid: &Grid, iso: f32, k: usize) {
-        let [nx, ny, _] = grid.points();
-        let layer = &values[grid.index(0, 0, k)..][..nx * ny];
-        for (row, bits) in layer.chunks_exact(nx).zip(self.bits.chunks_exact_mut(self.words)) {
-            for (chunk, word) in row.chunks(64).zip(bits.iter_mut()) {
-                *word = inside_bits(chunk, iso);
-            }
-        }
-    }
-
-    fn row(&self, j: usize) -> &[u64] {
-        &self.bits[j * self.words..(j + 1) * self.words]
-    }
-
-    /// Calls `visit(i)`, in increasing `i < cx`, for each cell of row `j` between this layer and
-    /// `above` whose eight corners are not all on one side.
-    fn for_each_mixed_cell(&self, above: &LayerSigns, j: usize, cx: usize, mut visit: impl FnMut(usize)) {
-        let rows = [self.row(j), self.row(j + 1), above.row(j), above.row(j + 1)];
-        let all = |w: usize| if w < self.words { rows.iter().fold(!0, |a, r| a & r[w]) } else { 0 };
-        let any = |w: usize| if w < self.words { rows.iter().fold(0, |a, r| a | r[w]) } else { 0 };
-        for w in 0..self.words {
-            // Point bit b is corner x of cell b; the cell's other x corner is bit b + 1, the next
-            // word's bit 0 for b = 63.
-            let (all_here, any_here) = (all(w), any(w));
-            let all_in = all_here & (all_here >> 1 | all(w + 1) << 63);
-            let any_in = any_here | any_here >> 1 | any(w + 1) << 63;
-            let mut mixed = any_in & !all_in;
-            let first = w * 64;
-            if cx - first < 64 {
-                mixed &= (1u64 << (cx - first)) - 1;
-            }
-            while mixed != 0 {
-                visit(first + mixed.trailing_zeros() as usize);
-                mixed &= mixed - 1;
-            }
-        }
-    }
 }
 
 /// The vertex on cell edge `e` of `cell` (values `d`): looked up in the cache, or placed by
@@ -569,11 +472,11 @@ impl Cell<'_> {
         &mut self,
         case: u8,
         joined: u8,
+        polygons: &CellPolygons,
         joins: &[(u8, u8, bool)],
         cache: &mut EdgeCache,
         mesh: &mut Mesh,
     ) {
-        let polygons = &polygon_table_with_faces()[(case as usize) << 6 | joined as usize];
         let (rest, tubes) = interior::tunnels(case, joined, polygons, joins);
         let all: Vec<&[u8]> = polygons.iter().collect();
         for k in rest {
