@@ -82,6 +82,14 @@ impl NearbyTriangles {
         out
     }
 
+    /// [`NearbyTriangles::near`] without changing the buckets, so that several threads may ask at
+    /// once; in increasing id.
+    pub fn near_shared(&self, corners: &[Vec3; 3]) -> Vec<u32> {
+        let (lo, hi) = bounds(&corners64(corners));
+        debug_assert!(self.region.as_ref().is_none_or(|r| r.covers(lo, hi)), "asked outside the region");
+        self.buckets.overlapping(lo, hi)
+    }
+
     /// Whether the triangle `ids` at `corners` crosses any recorded triangle of `mesh` nearby other
     /// than those in `skip`, by the self-intersection checker's rules (sharing an edge never
     /// counts, sharing a vertex counts when they overlap beyond it).

@@ -171,27 +171,49 @@ impl TriangleBuckets {
             self.seen.fill(0);
             self.stamp = 1;
         }
+        let mut seen = std::mem::take(&mut self.seen);
+        let stamp = self.stamp;
+        self.for_each_overlapping(lo, hi, |id| {
+            if seen[id as usize] != stamp {
+                seen[id as usize] = stamp;
+                out.push(id);
+            }
+        });
+        self.seen = seen;
+    }
+
+    /// [`TriangleBuckets::query`] without changing the buckets (so several threads can ask at
+    /// once), in increasing id.
+    pub fn overlapping(&self, lo: DVec3, hi: DVec3) -> Vec<u32> {
+        let mut out = Vec::new();
+        self.for_each_overlapping(lo, hi, |id| out.push(id));
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Calls `take` with every recorded triangle whose box overlaps `[lo, hi]` grown by a
+    /// thousandth of a cube, at least once each.
+    fn for_each_overlapping(&self, lo: DVec3, hi: DVec3, mut take: impl FnMut(u32)) {
         let margin = self.cell * 1e-3;
         let (lo, hi) = (lo - margin, hi + margin);
         let (a, b) = (self.coords(lo - self.loose_extent), self.coords(hi));
-        let TriangleBuckets { built, added, boxes, present, seen, stamp, .. } = self;
         let mut take = |id: u32| {
             let i = id as usize;
-            let (blo, bhi) = boxes[i];
-            if present[i] && seen[i] != *stamp && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
-                seen[i] = *stamp;
-                out.push(id);
+            let (blo, bhi) = self.boxes[i];
+            if self.present[i] && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
+                take(id);
             }
         };
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 // One row of cubes is one run of keys.
                 let (first, last) = (key([a[0], y, z]), key([b[0], y, z]));
-                let start = built.partition_point(|&(k, _)| k < first);
-                built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|&(_, id)| take(id));
-                if !added.is_empty() {
+                let start = self.built.partition_point(|&(k, _)| k < first);
+                self.built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|&(_, id)| take(id));
+                if !self.added.is_empty() {
                     for x in a[0]..=b[0] {
-                        added.get(&key([x, y, z])).into_iter().flatten().for_each(|&id| take(id));
+                        self.added.get(&key([x, y, z])).into_iter().flatten().for_each(|&id| take(id));
                     }
                 }
             }
