@@ -11,7 +11,10 @@
 //! Those passes only ever ask about a known region, the few cells around the fan centres, so
 //! only the triangles that reach into it are recorded ([`NearbyTriangles::around`]): at 256
 //! cells, recording all 400 000 triangles of the gear took 67 ms a pass, a third of the flips'
-//! time, for questions about a small share of them.
+//! time, for questions about a small share of them. The buckets keep boxes for the recorded
+//! triangles alone (a third of the gear's at 256 cells, a twentieth for the pull-backs): lists
+//! per triangle of the whole mesh, touched for the first time in every pass, cost the
+//! pull-backs a third of their time.
 
 use crate::mesh::analysis::bvh::Aabb;
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
@@ -49,15 +52,30 @@ impl NearbyTriangles {
         let region = Region::new(cell, region);
         // The scan over every triangle is most of the cost, and each triangle's answer is its
         // own: pieces of the list go to threads ([`crate::par`]) and are joined in order.
-        let mut boxes = vec![None; mesh.triangles.len()];
-        crate::par::map_chunks_mut(&mut boxes, SCAN_PIECE, |c, piece| {
-            for (k, b) in piece.iter_mut().enumerate() {
-                let (lo, hi) = bounds(&corners64(&mesh.corners(c * SCAN_PIECE + k)));
-                *b = region.overlaps(lo, hi).then_some((lo, hi));
+        // A box's lowest and highest cubes are those of its corners' lowest and highest, so
+        // each vertex's cube is found once.
+        let mut cubes = vec![[0i64; 3]; mesh.positions.len()];
+        crate::par::map_chunks_mut(&mut cubes, SCAN_PIECE, |c, piece| {
+            for (k, cube) in piece.iter_mut().enumerate() {
+                *cube = region.lattice.cube(mesh.positions[c * SCAN_PIECE + k].as_dvec3());
             }
         });
+        let pieces = crate::par::map(mesh.triangles.len().div_ceil(SCAN_PIECE), |c| {
+            let piece = c * SCAN_PIECE..((c + 1) * SCAN_PIECE).min(mesh.triangles.len());
+            let mut recorded = Vec::new();
+            for t in piece {
+                let [p, q, r] = mesh.triangles[t].map(|v| cubes[v as usize]);
+                let low = std::array::from_fn(|a| p[a].min(q[a]).min(r[a]));
+                let high = std::array::from_fn(|a| p[a].max(q[a]).max(r[a]));
+                if region.meets(low, high) {
+                    let (lo, hi) = bounds(&corners64(&mesh.corners(t)));
+                    recorded.push((t as u32, lo, hi));
+                }
+            }
+            recorded
+        });
         NearbyTriangles {
-            buckets: TriangleBuckets::build_some(cell, boxes.into_iter()),
+            buckets: TriangleBuckets::build_sparse(cell, mesh.triangles.len(), pieces.concat()),
             region: Some(region),
         }
     }
@@ -80,14 +98,6 @@ impl NearbyTriangles {
         let mut out = Vec::new();
         self.buckets.query(lo, hi, &mut out);
         out
-    }
-
-    /// [`NearbyTriangles::near`] without changing the buckets, so that several threads may ask at
-    /// once; in increasing id.
-    pub fn near_shared(&self, corners: &[Vec3; 3]) -> Vec<u32> {
-        let (lo, hi) = bounds(&corners64(corners));
-        debug_assert!(self.region.as_ref().is_none_or(|r| r.covers(lo, hi)), "asked outside the region");
-        self.buckets.overlapping(lo, hi)
     }
 
     /// Whether the triangle `ids` at `corners` crosses any recorded triangle of `mesh` nearby other
@@ -124,8 +134,12 @@ impl Lattice {
 
     /// Calls `f` with the number (`None`: outside the block) of every cube `[lo, hi]` overlaps,
     /// while it returns true; returns whether it always did.
-    fn cubes(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(Option<usize>) -> bool) -> bool {
-        let (a, z) = (self.cube(lo), self.cube(hi));
+    fn cubes(&self, lo: DVec3, hi: DVec3, f: impl FnMut(Option<usize>) -> bool) -> bool {
+        self.cube_range(self.cube(lo), self.cube(hi), f)
+    }
+
+    /// [`Lattice::cubes`] over the cubes from `a` to `z` (inclusive).
+    fn cube_range(&self, a: [i64; 3], z: [i64; 3], mut f: impl FnMut(Option<usize>) -> bool) -> bool {
         for cz in a[2]..=z[2] {
             for cy in a[1]..=z[1] {
                 for cx in a[0]..=z[0] {
@@ -179,8 +193,9 @@ impl Region {
         n.is_some_and(|n| self.bits[n / 64] >> (n % 64) & 1 == 1)
     }
 
-    fn overlaps(&self, lo: DVec3, hi: DVec3) -> bool {
-        !self.lattice.cubes(lo, hi, |n| !self.has(n))
+    /// Whether any cube from `a` to `z` (inclusive) is in the region.
+    fn meets(&self, a: [i64; 3], z: [i64; 3]) -> bool {
+        !self.lattice.cube_range(a, z, |n| !self.has(n))
     }
 
     fn covers(&self, lo: DVec3, hi: DVec3) -> bool {

@@ -18,25 +18,34 @@ use rustc_hash::FxHashMap;
 /// Triangle ids by where their bounding boxes lie, in cubes of side `cell`.
 pub struct TriangleBuckets {
     cell: f64,
-    /// (cube, id) for every triangle given to [`TriangleBuckets::build`], sorted.
+    /// (cube, slot) for every triangle given to [`TriangleBuckets::build`], sorted.
     built: Vec<(u64, u32)>,
-    /// Entries recorded one by one after the build, each id under the cubes of its last box
-    /// (its entries in `built` may be stale: `boxes` says where it is).
+    /// Slots recorded one by one after the build, each under the cubes of its last box (its
+    /// entries in `built` may be stale: `boxes` says where it is).
     added: FxHashMap<u64, Vec<u32>>,
-    /// Per id, its box as last recorded, whether it is recorded now, and whether it is in `added`.
+    /// Per triangle id, its slot in the per-slot lists below ([`NO_SLOT`]: never recorded). EMC
+    /// records a third of a mesh's triangles or fewer, and per-id lists of boxes for all of them
+    /// were most of the cost of building (memory touched for the first time).
+    slot_of: Vec<u32>,
+    /// Per slot: its triangle, its box as last recorded, whether it is recorded now, and whether
+    /// it is in `added`.
+    ids: Vec<u32>,
     boxes: Vec<(DVec3, DVec3)>,
     present: Vec<bool>,
     in_added: Vec<bool>,
     /// The largest extent, per axis, of a box recorded once (never more than a cube): how far
     /// below a query's box the low corner of one that overlaps it can lie.
     loose_extent: DVec3,
-    /// Query stamps per id, so a triangle listed twice is reported once.
+    /// Query stamps per slot, so a triangle listed twice is reported once.
     seen: Vec<u32>,
     stamp: u32,
 }
 
 /// Cube coordinates are kept within ±2²⁰, so that three fit one key.
 const KEY_RANGE: i64 = 1 << 20;
+
+/// [`TriangleBuckets::slot_of`] for a triangle that was never recorded.
+const NO_SLOT: u32 = u32::MAX;
 
 impl TriangleBuckets {
     /// Buckets of side `cell` over the triangles with these bounding boxes, ids 0, 1, 2, ….
@@ -47,28 +56,40 @@ impl TriangleBuckets {
     /// Buckets over the triangles given a box, ids 0, 1, 2, … (`None`: not recorded, until an
     /// [`insert`](Self::insert)).
     pub fn build_some(cell: f64, boxes: impl Iterator<Item = Option<(DVec3, DVec3)>>) -> TriangleBuckets {
-        let mut present = Vec::new();
-        let boxes: Vec<(DVec3, DVec3)> = boxes
-            .map(|b| {
-                present.push(b.is_some());
-                b.unwrap_or((DVec3::ZERO, DVec3::ZERO))
-            })
+        let mut count = 0;
+        let recorded: Vec<(u32, DVec3, DVec3)> = boxes
+            .inspect(|_| count += 1)
+            .enumerate()
+            .filter_map(|(id, b)| b.map(|(lo, hi)| (id as u32, lo, hi)))
             .collect();
+        TriangleBuckets::build_sparse(cell, count, recorded)
+    }
+
+    /// Buckets over `count` triangles of which those in `recorded` (id and box, in increasing
+    /// id) are recorded, until an [`insert`](Self::insert).
+    pub fn build_sparse(cell: f64, count: usize, recorded: Vec<(u32, DVec3, DVec3)>) -> TriangleBuckets {
+        let mut slot_of = vec![NO_SLOT; count];
+        for (slot, &(id, _, _)) in recorded.iter().enumerate() {
+            slot_of[id as usize] = slot as u32;
+        }
+        let slots = recorded.len();
         let mut out = TriangleBuckets {
             cell: if cell > 0.0 && cell.is_finite() { cell } else { 1.0 },
-            built: Vec::with_capacity(boxes.len()),
+            built: Vec::with_capacity(slots),
             added: FxHashMap::default(),
-            present,
-            in_added: vec![false; boxes.len()],
+            slot_of,
+            ids: recorded.iter().map(|&(id, _, _)| id).collect(),
+            boxes: recorded.into_iter().map(|(_, lo, hi)| (lo, hi)).collect(),
+            present: vec![true; slots],
+            in_added: vec![false; slots],
             loose_extent: DVec3::ZERO,
-            seen: vec![0; boxes.len()],
-            boxes,
+            seen: vec![0; slots],
             stamp: 0,
         };
         let mut built = std::mem::take(&mut out.built);
         let mut extent = DVec3::ZERO;
-        for (id, &(lo, hi)) in out.boxes.iter().enumerate().filter(|&(id, _)| out.present[id]) {
-            out.for_cubes(lo, hi, |k| built.push((k, id as u32)));
+        for (slot, &(lo, hi)) in out.boxes.iter().enumerate() {
+            out.for_cubes(lo, hi, |k| built.push((k, slot as u32)));
             extent = out.widen(extent, lo, hi);
         }
         out.loose_extent = extent;
@@ -111,24 +132,39 @@ impl TriangleBuckets {
         p.to_array().map(|x| ((x / self.cell).floor() as i64).clamp(-KEY_RANGE, KEY_RANGE - 1) + KEY_RANGE)
     }
 
+    /// The slot of triangle `id`, if it was ever recorded.
+    fn slot(&self, id: u32) -> Option<usize> {
+        self.slot_of.get(id as usize).filter(|&&s| s != NO_SLOT).map(|&s| s as usize)
+    }
+
     /// Records triangle `id` with this bounding box (in place of any box it had).
     pub fn insert(&mut self, id: u32, lo: DVec3, hi: DVec3) {
-        let i = id as usize;
-        if i >= self.boxes.len() {
-            self.boxes.resize(i + 1, (DVec3::ZERO, DVec3::ZERO));
-            self.present.resize(i + 1, false);
-            self.in_added.resize(i + 1, false);
-            self.seen.resize(i + 1, 0);
-        }
-        self.unlist(id);
-        self.boxes[i] = (lo, hi);
-        self.present[i] = true;
-        self.in_added[i] = true;
+        let s = match self.slot(id) {
+            Some(s) => {
+                self.unlist(s);
+                s
+            }
+            None => {
+                if id as usize >= self.slot_of.len() {
+                    self.slot_of.resize(id as usize + 1, NO_SLOT);
+                }
+                self.slot_of[id as usize] = self.ids.len() as u32;
+                self.ids.push(id);
+                self.boxes.push((lo, hi));
+                self.present.push(false);
+                self.in_added.push(false);
+                self.seen.push(0);
+                self.ids.len() - 1
+            }
+        };
+        self.boxes[s] = (lo, hi);
+        self.present[s] = true;
+        self.in_added[s] = true;
         self.loose_extent = self.widen(self.loose_extent, lo, hi);
         let mut keys = Vec::new();
         self.for_cubes(lo, hi, |k| keys.push(k));
         for k in keys {
-            self.added.entry(k).or_default().push(id);
+            self.added.entry(k).or_default().push(s as u32);
         }
     }
 
@@ -140,25 +176,24 @@ impl TriangleBuckets {
 
     /// Forgets triangle `id`.
     pub fn remove(&mut self, id: u32) {
-        if (id as usize) < self.present.len() {
-            self.unlist(id);
-            self.present[id as usize] = false;
+        if let Some(s) = self.slot(id) {
+            self.unlist(s);
+            self.present[s] = false;
         }
     }
 
-    /// Takes `id` out of the lists in `added`, so that they hold no stale entries to scan.
-    fn unlist(&mut self, id: u32) {
-        let i = id as usize;
-        if !self.in_added[i] {
+    /// Takes slot `s` out of the lists in `added`, so that they hold no stale entries to scan.
+    fn unlist(&mut self, s: usize) {
+        if !self.in_added[s] {
             return;
         }
-        self.in_added[i] = false;
-        let (lo, hi) = self.boxes[i];
+        self.in_added[s] = false;
+        let (lo, hi) = self.boxes[s];
         let mut keys = Vec::new();
         self.for_cubes(lo, hi, |k| keys.push(k));
         for k in keys {
             if let Some(list) = self.added.get_mut(&k) {
-                list.retain(|&u| u != id);
+                list.retain(|&u| u as usize != s);
             }
         }
     }
@@ -173,36 +208,26 @@ impl TriangleBuckets {
         }
         let mut seen = std::mem::take(&mut self.seen);
         let stamp = self.stamp;
-        self.for_each_overlapping(lo, hi, |id| {
-            if seen[id as usize] != stamp {
-                seen[id as usize] = stamp;
-                out.push(id);
+        self.for_each_overlapping(lo, hi, |s| {
+            if seen[s] != stamp {
+                seen[s] = stamp;
+                out.push(self.ids[s]);
             }
         });
         self.seen = seen;
     }
 
-    /// [`TriangleBuckets::query`] without changing the buckets (so several threads can ask at
-    /// once), in increasing id.
-    pub fn overlapping(&self, lo: DVec3, hi: DVec3) -> Vec<u32> {
-        let mut out = Vec::new();
-        self.for_each_overlapping(lo, hi, |id| out.push(id));
-        out.sort_unstable();
-        out.dedup();
-        out
-    }
-
-    /// Calls `take` with every recorded triangle whose box overlaps `[lo, hi]` grown by a
-    /// thousandth of a cube, at least once each.
-    fn for_each_overlapping(&self, lo: DVec3, hi: DVec3, mut take: impl FnMut(u32)) {
+    /// Calls `take` with the slot of every recorded triangle whose box overlaps `[lo, hi]` grown
+    /// by a thousandth of a cube, at least once each.
+    fn for_each_overlapping(&self, lo: DVec3, hi: DVec3, mut take: impl FnMut(usize)) {
         let margin = self.cell * 1e-3;
         let (lo, hi) = (lo - margin, hi + margin);
         let (a, b) = (self.coords(lo - self.loose_extent), self.coords(hi));
-        let mut take = |id: u32| {
-            let i = id as usize;
-            let (blo, bhi) = self.boxes[i];
-            if self.present[i] && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
-                take(id);
+        let mut take = |&slot: &u32| {
+            let s = slot as usize;
+            let (blo, bhi) = self.boxes[s];
+            if self.present[s] && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
+                take(s);
             }
         };
         for z in a[2]..=b[2] {
@@ -210,10 +235,10 @@ impl TriangleBuckets {
                 // One row of cubes is one run of keys.
                 let (first, last) = (key([a[0], y, z]), key([b[0], y, z]));
                 let start = self.built.partition_point(|&(k, _)| k < first);
-                self.built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|&(_, id)| take(id));
+                self.built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|(_, s)| take(s));
                 if !self.added.is_empty() {
                     for x in a[0]..=b[0] {
-                        self.added.get(&key([x, y, z])).into_iter().flatten().for_each(|&id| take(id));
+                        self.added.get(&key([x, y, z])).into_iter().flatten().for_each(&mut take);
                     }
                 }
             }
