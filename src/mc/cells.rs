@@ -54,9 +54,8 @@ impl CellTables {
     }
 }
 
-/// A sweep up a grid's cell layers that finds, in each, the cells the level crosses. Most cells
-/// are far from the level; with each point layer's signs as bits ([`LayerSigns`]) a row of 64
-/// cells is found empty in a few word operations, and only the crossed cells read their values.
+/// A sweep up a grid's cell layers that finds, in each, the cells the level crosses, from each
+/// point layer's signs as bits ([`LayerSigns`]).
 pub(crate) struct CrossedCells<'a> {
     values: &'a [f32],
     grid: &'a Grid,

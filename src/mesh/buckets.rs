@@ -206,39 +206,27 @@ impl TriangleBuckets {
             self.seen.fill(0);
             self.stamp = 1;
         }
-        let mut seen = std::mem::take(&mut self.seen);
-        let stamp = self.stamp;
-        self.for_each_overlapping(lo, hi, |s| {
-            if seen[s] != stamp {
-                seen[s] = stamp;
-                out.push(self.ids[s]);
-            }
-        });
-        self.seen = seen;
-    }
-
-    /// Calls `take` with the slot of every recorded triangle whose box overlaps `[lo, hi]` grown
-    /// by a thousandth of a cube, at least once each.
-    fn for_each_overlapping(&self, lo: DVec3, hi: DVec3, mut take: impl FnMut(usize)) {
         let margin = self.cell * 1e-3;
         let (lo, hi) = (lo - margin, hi + margin);
         let (a, b) = (self.coords(lo - self.loose_extent), self.coords(hi));
+        let TriangleBuckets { built, added, ids, boxes, present, seen, stamp, .. } = self;
         let mut take = |&slot: &u32| {
             let s = slot as usize;
-            let (blo, bhi) = self.boxes[s];
-            if self.present[s] && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
-                take(s);
+            let (blo, bhi) = boxes[s];
+            if present[s] && seen[s] != *stamp && blo.cmple(hi).all() && bhi.cmpge(lo).all() {
+                seen[s] = *stamp;
+                out.push(ids[s]);
             }
         };
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 // One row of cubes is one run of keys.
                 let (first, last) = (key([a[0], y, z]), key([b[0], y, z]));
-                let start = self.built.partition_point(|&(k, _)| k < first);
-                self.built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|(_, s)| take(s));
-                if !self.added.is_empty() {
+                let start = built.partition_point(|&(k, _)| k < first);
+                built[start..].iter().take_while(|&&(k, _)| k <= last).for_each(|(_, s)| take(s));
+                if !added.is_empty() {
                     for x in a[0]..=b[0] {
-                        self.added.get(&key([x, y, z])).into_iter().flatten().for_each(&mut take);
+                        added.get(&key([x, y, z])).into_iter().flatten().for_each(&mut take);
                     }
                 }
             }
