@@ -27,7 +27,7 @@ pub struct CrustSamples {
 /// interval bounds (then the caller samples every point).
 pub fn sample_crust(field: &dyn Field, grid: &Grid, iso: f32) -> Option<Result<CrustSamples, Error>> {
     field.interval(grid.origin, grid.origin + grid.spacing)?;
-    let traversal = Traversal { field, grid, iso };
+    let traversal = Traversal { field, grid, iso, within: crate::field::level_tolerance(grid, iso) };
     let (boxes, interval_queries) = traversal.boxes([0, 0, 0], grid.cells);
     let samples = Samples::from_boxes(grid, &boxes);
     Some(samples.finish(field, interval_queries))
@@ -48,6 +48,8 @@ struct Traversal<'a> {
     field: &'a dyn Field,
     grid: &'a Grid,
     iso: f32,
+    /// How near the level a bound proves nothing ([`crate::field::level_tolerance`]).
+    within: f32,
 }
 
 impl Traversal<'_> {
@@ -90,7 +92,9 @@ impl Traversal<'_> {
         let (wlo, whi) = (self.grid.position(lo[0], lo[1], lo[2]), self.grid.position(hi[0], hi[1], hi[2]));
         let (vlo, vhi) = self.field.interval(wlo, whi).unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
         // The bound itself stands in (not `bound - iso + iso`, which may round onto the level).
-        if vlo > self.iso || vhi < self.iso {
+        // A bound within evaluation error of the level proves no sign: the box's points are
+        // sampled and snapped like any others ([`crate::field::snap_to_level`]).
+        if vlo > self.iso + self.within || vhi < self.iso - self.within {
             return Err(Decided::Fill { lo, hi, value: if vlo > self.iso { vlo } else { vhi } });
         }
         let sizes = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];

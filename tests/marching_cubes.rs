@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assert_watertight, Rng};
-use isoforge::field::sample_grid;
+use isoforge::field::{sample_grid, sample_level};
 use isoforge::mc::{self, McOptions, Topology};
 use isoforge::mesh::analysis;
 use isoforge::{scenes, Error, Grid, Vec3};
@@ -290,4 +290,100 @@ fn bad_input_is_reported_not_meshed() {
     let opts = McOptions { max_cells: 7, ..McOptions::default() };
     assert!(matches!(mc::mesh_samples(&[1.0; 27], &grid, &opts), Err(Error::GridTooLarge { cells: 8, .. })));
     assert!(scenes::scene("no_such_scene").is_err());
+}
+
+/// A box of grid points: `lo..=hi` in grid indices along each axis.
+type PointBox = ([i64; 3], [i64; 3]);
+
+/// Random unions of one to three boxes whose faces lie on grid planes (written as decimals, so
+/// their samples on those planes are zero only up to rounding), some sharing a face: every sample
+/// takes its side by the rule of `field::snap_to_level`, whatever the rounding, through the crust
+/// and without. Strictly inside a box: inside; in no box: outside; on a face, inside only where
+/// it lies between two inside points along a grid line and between two points of air along none,
+/// otherwise exactly on the level (outside). Rounding made such unions' faces step between grid
+/// planes in teeth (`tests/emc_quality.rs`) and split parts sharing a face along it.
+#[test]
+fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
+    for seed in common::case_seeds(19_000, 24) {
+        let mut rng = Rng::new(seed);
+        let res = 16 + 2 * rng.below(17) as i64;
+        let h = 2.0 / res as f64;
+        let mut boxes: Vec<PointBox> = Vec::new();
+        for n in 0..1 + rng.below(3) {
+            let mut lo = [0i64; 3];
+            let mut hi = [0i64; 3];
+            for a in 0..3 {
+                lo[a] = 2 + rng.below(res as u64 / 2) as i64;
+                hi[a] = (lo[a] + 2 + rng.below(res as u64 / 3) as i64).min(res - 2);
+            }
+            if n > 0 && rng.below(2) == 0 {
+                // Flush against the previous box's face along one axis, overlapping it across.
+                let (plo, phi) = *boxes.last().unwrap();
+                let a = rng.below(3) as usize;
+                let width = hi[a] - lo[a];
+                (lo[a], hi[a]) = (phi[a], (phi[a] + width).min(res - 2));
+                for b in (0..3).filter(|&b| b != a) {
+                    (lo[b], hi[b]) = (plo[b], phi[b]);
+                }
+            }
+            if (0..3).all(|a| hi[a] > lo[a]) {
+                boxes.push((lo, hi));
+            }
+        }
+        let coord = |g: f64| -1.0 + g * h;
+        let parts: Vec<String> = boxes
+            .iter()
+            .map(|(lo, hi)| {
+                let half = [0, 1, 2].map(|a| (hi[a] - lo[a]) as f64 * h / 2.0);
+                let centre = [0, 1, 2].map(|a| coord((lo[a] + hi[a]) as f64 / 2.0));
+                format!(
+                    "translate(box({}, {}, {}), {}, {}, {})",
+                    half[0] as f32,
+                    half[1] as f32,
+                    half[2] as f32,
+                    centre[0] as f32,
+                    centre[1] as f32,
+                    centre[2] as f32
+                )
+            })
+            .collect();
+        let text = parts.iter().skip(1).fold(parts[0].clone(), |acc, p| format!("union({acc}, {p})"));
+        let field = isoforge::expr::compile(&text).unwrap();
+        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res as usize).unwrap();
+        let strictly =
+            |g: [i64; 3]| boxes.iter().any(|(lo, hi)| (0..3).all(|a| lo[a] < g[a] && g[a] < hi[a]));
+        let closed =
+            |g: [i64; 3]| boxes.iter().any(|(lo, hi)| (0..3).all(|a| lo[a] <= g[a] && g[a] <= hi[a]));
+        for crust in [true, false] {
+            let (values, _) = sample_level(&field, &grid, 0.0, crust).unwrap();
+            let mut on_faces = 0;
+            for (n, &v) in values.iter().enumerate() {
+                let [i, j, k] = grid.unindex(n);
+                let g = [i as i64, j as i64, k as i64];
+                let what = format!("seed {seed}: {text} at {res}, point {g:?}, crust {crust}: {v}");
+                if strictly(g) {
+                    assert!(v < 0.0, "{what}: inside");
+                } else if !closed(g) {
+                    assert!(v > 0.0, "{what}: outside");
+                } else {
+                    on_faces += 1;
+                    let step = |a: usize, s: i64| {
+                        let mut q = g;
+                        q[a] += s;
+                        q
+                    };
+                    let inner =
+                        |a: usize| g[a] > 0 && g[a] < res && strictly(step(a, -1)) && strictly(step(a, 1));
+                    let air =
+                        |a: usize| g[a] > 0 && g[a] < res && !closed(step(a, -1)) && !closed(step(a, 1));
+                    if (0..3).any(inner) && !(0..3).any(air) {
+                        assert!(v < 0.0, "{what}: between two parts");
+                    } else {
+                        assert_eq!(v, 0.0, "{what}: on the surface");
+                    }
+                }
+            }
+            assert!(on_faces > 0, "seed {seed}: no face on a grid plane");
+        }
+    }
 }

@@ -30,7 +30,7 @@ pub mod untangle;
 pub mod winding;
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_grid, Field};
+use crate::field::{check_finite, sample_level, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{ms_since, CellTables, EdgeCache, Topology, NONE};
 use crate::mcq::PolygonRules;
@@ -168,12 +168,7 @@ pub fn mesh_field(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let crust =
-        if options.crust { crate::crust::sample_crust(field, grid, options.iso).transpose()? } else { None };
-    let (values, evaluated) = match crust {
-        Some(c) => (c.values, c.evaluated),
-        None => (sample_grid(field, grid)?, grid.point_count()),
-    };
+    let (values, evaluated) = sample_level(field, grid, options.iso, options.crust)?;
     let sample_ms = ms_since(t0);
     let sampler = FieldRoots { field, iso: options.iso, directed: options.directed, h: grid.cell_size() };
     let (mut mesh, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;

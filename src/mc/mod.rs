@@ -9,7 +9,7 @@
 //! the topology stays that of the sign pattern.
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_grid, Field};
+use crate::field::{check_finite, sample_level, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mesh::analysis::self_intersect::indexed_pair_intersects;
 use crate::mesh::Mesh;
@@ -92,10 +92,7 @@ pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McOptions) -> Result
     let t0 = Instant::now();
     // Where the field bounds itself, only the crust is evaluated: the mesh is the same, since a
     // cell away from the surface has one sign on either grid (see `crate::crust`).
-    let values = match crate::crust::sample_crust(field, grid, options.iso) {
-        Some(crust) => crust?.values,
-        None => sample_grid(field, grid)?,
-    };
+    let (values, _) = sample_level(field, grid, options.iso, true)?;
     timings.sample_ms = ms_since(t0);
     crate::progress::checkpoint("extract", 0.0)?;
     let t1 = Instant::now();

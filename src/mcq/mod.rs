@@ -13,7 +13,7 @@ mod snap;
 pub use polygon::PolygonRules;
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_grid, Field, SampleGradient, SampledField};
+use crate::field::{check_finite, sample_level, Field, SampleGradient, SampledField};
 use crate::grid::{in_box, Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{edge_vertex, for_each_crossed_cell, ms_since, set_normals};
 use crate::mesh::{analysis, Mesh};
@@ -124,7 +124,7 @@ pub(crate) struct CellPolygon {
 pub fn mesh_field(field: &dyn Field, grid: &Grid, options: &McqOptions) -> Result<(Mesh, McqReport), Error> {
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let values = sample_grid(field, grid)?;
+    let (values, _) = sample_level(field, grid, options.iso, false)?;
     let sample_ms = ms_since(t0);
     let (mesh, mut report) = extract(&values, grid, options, field)?;
     report.sample_ms = sample_ms;

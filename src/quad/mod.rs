@@ -26,7 +26,7 @@ pub mod semilocal;
 pub mod subdivide;
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_grid, Field};
+use crate::field::{check_finite, sample_level, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::ms_since;
 pub use extract::ExtractCounts;
@@ -107,7 +107,7 @@ pub fn mesh_field(
 ) -> Result<(QuadResult, Vec<(String, f64)>), Error> {
     check_size(grid, options.max_cells)?;
     let t = Instant::now();
-    let values = sample_grid(field, grid)?;
+    let (values, _) = sample_level(field, grid, 0.0, false)?;
     let phases = vec![("sample".to_string(), ms_since(t))];
     mesh_values(&values, field, grid, options, phases)
 }
