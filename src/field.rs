@@ -347,15 +347,15 @@ pub fn sample_level(
 /// and from primitive to primitive: in a union of two such boxes the samples on a face came out
 /// -4e-8, 0 and 1e-8, some points of the face inside and some outside, and the surface stepped
 /// between grid planes in teeth. The error of evaluating a distance at coordinates of magnitude
-/// `C` is a few float spacings of `C`; within sixteen of them ([`level_tolerance`]) a
-/// sample is on the level, and outside, as an exact zero always was: a box's faces stay exact.
-/// Except between two inside samples: there the zero comes from parts of a union that share a
-/// face (`min` of two distances is zero all over it), and outside they would split the solid in
-/// two along the face (the rocket's body and nose at 160 cells, tried). Where air lies on both sides
+/// `C` is a few float spacings of `C`; within sixteen of them ([`level_tolerance`]) a sample is
+/// on the level, and outside, as an exact zero always was: a box's faces stay exact. Except
+/// between two inside samples: there the zero comes from parts of a union that share a face
+/// (`min` of two distances is zero all over it), and outside they would split the solid in two
+/// along the face (the rocket's body and nose at 160 cells, tried). Where air lies on both sides
 /// along another line, the parts touch only there (two balls touching at a grid point) and the
-/// point stays outside, the parts apart, as before. Samples given as data are the
-/// caller's and are not changed. The surface moves by at most the tolerance (crossings keep a
-/// thousandth of an edge off their ends anyway: [`crate::mc::MIN_EDGE_FRACTION`]).
+/// point stays outside, the parts apart, as before. Samples given as data are the caller's and
+/// are not changed. The surface moves by at most the tolerance (crossings keep a thousandth of an
+/// edge off their ends anyway: [`crate::mc::MIN_EDGE_FRACTION`]).
 pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32) {
     let within = level_tolerance(grid, iso);
     // Few samples lie on the level: runs of them are ruled out in one vectorised pass each (a
