@@ -374,7 +374,7 @@ pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32) {
     let [nx, ny, nz] = grid.points();
     // Per axis through the point: both neighbours inside, both clearly outside.
     let flanks = |n: usize| {
-        let (i, j, k) = (n % nx, n / nx % ny, n / (nx * ny));
+        let [i, j, k] = grid.unindex(n);
         [(i, nx, 1), (j, ny, nx), (k, nz, nx * ny)].map(|(at, count, step)| {
             let ends = (at > 0 && at + 1 < count).then(|| [values[n - step] - iso, values[n + step] - iso]);
             ends.map_or((false, false), |e| (e.iter().all(|&d| d < -within), e.iter().all(|&d| d > within)))

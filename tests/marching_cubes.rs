@@ -360,11 +360,11 @@ fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
             for (n, &v) in values.iter().enumerate() {
                 let [i, j, k] = grid.unindex(n);
                 let g = [i as i64, j as i64, k as i64];
-                let what = format!("seed {seed}: {text} at {res}, point {g:?}, crust {crust}: {v}");
+                let what = || format!("seed {seed}: {text} at {res}, point {g:?}, crust {crust}: {v}");
                 if strictly(g) {
-                    assert!(v < 0.0, "{what}: inside");
+                    assert!(v < 0.0, "{}: inside", what());
                 } else if !closed(g) {
-                    assert!(v > 0.0, "{what}: outside");
+                    assert!(v > 0.0, "{}: outside", what());
                 } else {
                     on_faces += 1;
                     let step = |a: usize, s: i64| {
@@ -377,9 +377,9 @@ fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
                     let air =
                         |a: usize| g[a] > 0 && g[a] < res && !closed(step(a, -1)) && !closed(step(a, 1));
                     if (0..3).any(inner) && !(0..3).any(air) {
-                        assert!(v < 0.0, "{what}: between two parts");
+                        assert!(v < 0.0, "{}: between two parts", what());
                     } else {
-                        assert_eq!(v, 0.0, "{what}: on the surface");
+                        assert_eq!(v, 0.0, "{}: on the surface", what());
                     }
                 }
             }
