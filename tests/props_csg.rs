@@ -394,6 +394,22 @@ fn dmc_does_not_cross_itself_on_seed_4500068() {
     sound(&case, "dmc", &dmc.mesh, true, CROSSING_AND_FOLD_FREE);
 }
 
+/// Flat closed bubbles lying on the surface, one face of each turned over (174° and 165°), found by
+/// a soak of 100 trees: a dual vertex alone on its side among the vertices it is joined to, once
+/// stopped on its leaf's corner on a ridge of the field 0.18 cells inside, once a hair inside on a
+/// crease. Such a vertex now takes its leaf centre's side (`dmc::build`, `settle_isolated`). Seed
+/// 10500067 also has fine MC's topology again (a third component before); 10500089's has a torus
+/// whose tube is a seventeenth of a cell thick, so its topology is not promised.
+#[test]
+fn dmc_wraps_no_lone_vertex_in_a_bubble_on_seeds_10500067_and_10500089() {
+    for seed in [10_500_067, 10_500_089] {
+        check_dmc_quality(&Case::new(seed));
+    }
+    let case = Case::new(10_500_067);
+    let (fine, finest) = resolved_fine_mc(&case).expect("fine MC resolves this tree");
+    assert_dmc_has_the_topology_of(&case, &fine, finest);
+}
+
 /// The hollow ball of issue 15 (MC: two spheres), at shell thicknesses from a third of the
 /// bounds down to a sixth of a finest cell: the crust is found by interval bounds, never by
 /// samples, so no shell is missed. (At a tenth of a cell, 0.006, the shell is perforated where

@@ -140,6 +140,97 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
             node.value = super::dual::side_only(inside);
         }
     }
+    settle_isolated(tree, field, iso, &crust, &centres);
+}
+
+/// Whether the dual vertex of the leaf holding finest cell `q` (offset by `d`) is inside; beyond
+/// the grid the vertices are the boundary's copies, always outside.
+fn neighbour_inside(tree: &Octree, q: [u32; 3], d: [i32; 3]) -> bool {
+    let mut at = [0u32; 3];
+    for a in 0..3 {
+        let c = q[a] as i64 + d[a] as i64;
+        if c < 0 || c >= tree.cells[a] as i64 {
+            return false;
+        }
+        at[a] = c as u32;
+    }
+    let node = &tree.nodes[tree.locate(at, super::tree::NONE) as usize];
+    match node.kind {
+        Kind::Empty { inside } => inside,
+        _ => node.value < 0.0,
+    }
+}
+
+/// The crust vertices that the finest level's contour would wrap in a bubble of their own, moved
+/// to their leaf centre's side.
+///
+/// A vertex whose side differs from its leaf centre's is what lets a wall thinner than a cell
+/// survive, but only as part of the wall: its neighbours along the wall share its side. One that
+/// shares its side with none of the vertices it is joined to (an inside vertex with every face
+/// neighbour's vertex outside; an outside one with all 26 around it inside, since Marching Cubes'
+/// table joins outside corners across faces and cubes) is alone in its side of the dual grid, and
+/// the contour closes a bubble around it. Where the centre agrees with it, that bubble is a part
+/// smaller than a cell seen by its centre, and stays; where it does not, the vertex was drawn there
+/// by a feature of the function (a ridge inside the solid that the QEF reached by stopping at its
+/// leaf's corner, or a crease whose vertex lies a hair on the other side of the level, found on
+/// random CSG trees: flat bubbles lying on the surface, one face turned over). So such a vertex
+/// takes its centre's side, as Marching Cubes on the lattice of centres gives it. Two such
+/// vertices cannot be neighbours (each would need the other's neighbours on both sides), so one
+/// pass decides them all.
+fn settle_isolated(tree: &mut Octree, field: &Clipped, iso: f32, crust: &[u32], centres: &[Vec3]) {
+    const FACES: [[i32; 3]; 6] = [[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1], [0, 0, 1]];
+    let around: Vec<[i32; 3]> =
+        (0..27).map(|i| [i % 3 - 1, i / 3 % 3 - 1, i / 9 - 1]).filter(|d| *d != [0, 0, 0]).collect();
+    let isolated: Vec<usize> = (0..crust.len())
+        .filter(|&i| {
+            let node = &tree.nodes[crust[i] as usize];
+            let (q, inside) = (node.coord, node.value < 0.0);
+            if inside {
+                FACES.iter().all(|&d| !neighbour_inside(tree, q, d))
+            } else {
+                around.iter().all(|&d| neighbour_inside(tree, q, d))
+            }
+        })
+        .collect();
+    let points: Vec<Vec3> = isolated.iter().map(|&i| centres[i]).collect();
+    let mut at_centre = vec![0.0; points.len()];
+    field.values(&points, &mut at_centre);
+    for (&i, &fc) in isolated.iter().zip(&at_centre) {
+        let n = crust[i] as usize;
+        let (v, value) = (tree.nodes[n].vertex, tree.nodes[n].value);
+        let inside = fc < iso;
+        if (value < 0.0) == inside {
+            continue;
+        }
+        let (moved, f) = toward_side(field, iso, v, centres[i], inside, fc);
+        tree.nodes[n].vertex = moved;
+        tree.nodes[n].value = f - iso;
+    }
+}
+
+/// The point nearest `v` on the segment to `centre` (where the field is `f_centre`, on the side
+/// `inside`) at which the field is on that side too, by bisection, and the field there.
+fn toward_side(
+    field: &dyn Field,
+    iso: f32,
+    v: Vec3,
+    centre: Vec3,
+    inside: bool,
+    f_centre: f32,
+) -> (Vec3, f32) {
+    let (mut bad, mut good) = (0.0f32, 1.0f32);
+    let mut good_value = f_centre;
+    for _ in 0..8 {
+        let mid = 0.5 * (bad + good);
+        let f = field.value(v + (centre - v) * mid);
+        if (f < iso) == inside {
+            good = mid;
+            good_value = f;
+        } else {
+            bad = mid;
+        }
+    }
+    (v + (centre - v) * good, good_value)
 }
 
 /// Each vertex's value `f - iso`, and the vertex moved where its side had to be decided.
@@ -180,21 +271,7 @@ pub fn settle_vertices(
             continue;
         }
         // The field agrees at the centre: find where it starts to, nearest the vertex.
-        let (v, c) = (vertices[i], centres[i]);
-        let (mut bad, mut good) = (0.0f32, 1.0f32);
-        let mut good_value = at_centre[k];
-        for _ in 0..8 {
-            let mid = 0.5 * (bad + good);
-            let f = field.value(v + (c - v) * mid);
-            if (f < iso) == inside {
-                good = mid;
-                good_value = f;
-            } else {
-                bad = mid;
-            }
-        }
-        vertices[i] = v + (c - v) * good;
-        at[i] = good_value;
+        (vertices[i], at[i]) = toward_side(field, iso, vertices[i], centres[i], inside, at_centre[k]);
     }
     at.iter().map(|v| v - iso).collect()
 }
