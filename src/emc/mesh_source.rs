@@ -63,7 +63,8 @@ pub struct MeshBvh {
     /// way): an exporter's duplicate would count twice in every winding number through it and
     /// turn its side of the surface inside out.
     pub duplicates: usize,
-    /// Whether the input was inside out (negative enclosed volume) and was turned around.
+    /// Whether the input was inside out (negative enclosed volume, or winding number where it has
+    /// holes) and was turned around.
     pub flipped: bool,
     /// Edges of the input used by an odd number of triangles (`open_edges`): the edges of its
     /// holes or border. Where there are any, inside is decided by the generalised winding number.
@@ -72,9 +73,27 @@ pub struct MeshBvh {
 }
 
 impl MeshBvh {
+    /// Whether the generalised winding number exceeds 1/2 (inside, as [`grid_values`] decides it)
+    /// at a point just beside one of the faces: a thousandth of the face's longest edge off its
+    /// centroid, on either side, for up to [`FACE_PROBES`] faces spread over the mesh. Beside a
+    /// closed surface's face the number is 1 on the inside; beside a flat sheet it stays under
+    /// 1/2 on both sides.
+    pub fn encloses_beside_faces(&self) -> bool {
+        let Some(tree) = &self.winding else { return false };
+        let stride = self.triangles.len().div_ceil(FACE_PROBES).max(1);
+        self.triangles.iter().zip(&self.normals).step_by(stride).any(|(t, &n)| {
+            let [a, b, c] = *t;
+            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
+            let centroid = (a + b + c) / 3.0;
+            [-1.0f32, 1.0].iter().any(|&side| tree.winding(centroid + n * (side * 1e-3 * longest)) > 0.5)
+        })
+    }
+
     /// Indexes the triangles of `mesh`. Triangles without area are left out (no ray can hit them
-    /// and they have no normal), and so are repeats of a triangle already listed; a mesh whose triangles enclose a negative volume is taken to be
-    /// inside out and turned around, so normals point out of the solid either way.
+    /// and they have no normal), and so are repeats of a triangle already listed; a mesh whose
+    /// triangles enclose a negative volume (with holes: whose winding number is negative, see
+    /// `inside_out_by_winding`) is taken to be inside out and turned around, so normals point
+    /// out of the solid either way.
     pub fn new(mesh: &Mesh) -> Result<MeshBvh, Error> {
         let n = mesh.positions.len();
         if let Some(t) = mesh.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
@@ -121,7 +140,7 @@ impl MeshBvh {
             )));
         }
         let open_edges = open_edges(mesh).len();
-        let flipped = volume < 0.0;
+        let flipped = if open_edges > 0 { inside_out_by_winding(&triangles) } else { volume < 0.0 };
         if flipped {
             for t in &mut triangles {
                 t.swap(1, 2);
@@ -438,12 +457,44 @@ pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
     values
 }
 
+/// Whether triangles with holes are wound inside out, by their generalised winding number. Just
+/// behind a face (against its normal) and just in front of it the number is about 1 and 0 where
+/// the faces are wound outward, 0 and -1 where they are wound the other way, holes or not; so the
+/// area-weighted sum of the two over the faces (up to [`FACE_PROBES`] of them) has the winding's
+/// sign. The enclosed volume, which decides for closed meshes, depends on the point it is taken
+/// about once faces are missing: a face missing from a small part far from that point outweighs
+/// the part's whole volume (random shells meshed into specks, a few faces punched out, were
+/// turned inside out and then refused as enclosing nothing).
+fn inside_out_by_winding(triangles: &[[Vec3; 3]]) -> bool {
+    let tree = WindingTree::new(triangles);
+    let stride = triangles.len().div_ceil(FACE_PROBES).max(1);
+    let sum: f64 = triangles
+        .iter()
+        .step_by(stride)
+        .map(|&[a, b, c]| {
+            let cross = (b - a).cross(c - a);
+            let n = cross.normalize_or_zero();
+            let step = 1e-3 * a.distance(b).max(b.distance(c)).max(c.distance(a));
+            let centroid = (a + b + c) / 3.0;
+            let w = tree.winding(centroid - n * step) + tree.winding(centroid + n * step);
+            cross.length() as f64 * w
+        })
+        .sum();
+    sum < 0.0
+}
+
+/// Faces [`MeshBvh::encloses_beside_faces`] looks beside at most.
+pub const FACE_PROBES: usize = 1024;
+
 /// Refuses the grid values of a mesh with holes where no grid point is inside: an open surface
 /// that bounds nothing (a sheet, a lone face) has a winding number below 1/2 everywhere, and an
-/// empty output would say nothing about why. A closed mesh whose solid falls between the grid
-/// points meshes to nothing as any surface smaller than a cell does.
+/// empty output would say nothing about why. A solid whose inside falls between the grid points
+/// meshes to nothing as any surface smaller than a cell does, with holes or without: so before
+/// refusing, the winding number is also taken just beside the mesh's faces
+/// ([`MeshBvh::encloses_beside_faces`]), where a thin shell with a few holes is inside and a sheet
+/// is not.
 pub fn check_encloses(mesh: &MeshBvh, values: &[f32]) -> Result<(), Error> {
-    if mesh.open_edges > 0 && !values.iter().any(|&v| v < 0.0) {
+    if mesh.open_edges > 0 && !values.iter().any(|&v| v < 0.0) && !mesh.encloses_beside_faces() {
         return Err(Error::InvalidOption(format!(
             "the mesh has {} open edges (holes or a border) and encloses nothing: its generalised \
              winding number is below 1/2 at every grid point, so it is a sheet rather than the \
@@ -681,6 +732,60 @@ mod tests {
         let mut sliver = holed.clone();
         sliver.triangles.push([0, 0, 1]);
         assert_eq!(open_edges(&sliver).len(), 3);
+    }
+
+    /// `cube()` scaled by `size` about its lowest corner, moved to `at`, with triangle `punched`
+    /// left out where there is one.
+    fn punched_cube(size: Vec3, at: Vec3, punched: Option<usize>) -> Mesh {
+        let mut m = cube();
+        for p in &mut m.positions {
+            *p = at + *p * size;
+        }
+        if let Some(t) = punched {
+            m.triangles.remove(t);
+        }
+        m
+    }
+
+    fn joined(a: &Mesh, b: &Mesh) -> Mesh {
+        let mut m = a.clone();
+        let n = m.positions.len() as u32;
+        m.positions.extend(&b.positions);
+        m.triangles.extend(b.triangles.iter().map(|t| t.map(|v| v + n)));
+        m
+    }
+
+    #[test]
+    fn holed_meshes_keep_their_winding_wherever_their_parts_lie() {
+        // Two small cubes at opposite corners of the box, a face punched out of one: the enclosed
+        // volume about the box's middle is the missing face's, negative where that face looked
+        // away from the middle; the winding number is not fooled.
+        for punched in 0..12 {
+            let a = punched_cube(Vec3::splat(0.01), Vec3::ZERO, Some(punched));
+            let b = punched_cube(Vec3::splat(0.01), Vec3::ONE, None);
+            let m = MeshBvh::new(&joined(&a, &b)).unwrap();
+            assert!(m.open_edges > 0 && !m.flipped, "face {punched} punched: turned inside out");
+            let mut inverted = joined(&a, &b);
+            for t in &mut inverted.triangles {
+                t.swap(1, 2);
+            }
+            assert!(MeshBvh::new(&inverted).unwrap().flipped, "face {punched} punched, inverted");
+        }
+    }
+
+    #[test]
+    fn thin_solids_with_holes_are_not_sheets() {
+        // A slab a thousandth of its width thick, a face punched out of its top: no grid point
+        // falls inside it, as none would were it closed, and it meshes to nothing rather than
+        // being refused as a sheet.
+        let slab = punched_cube(Vec3::new(1.0, 1.0, 0.001), Vec3::new(0.0, 0.0, 0.0123), Some(11));
+        let source = MeshBvh::new(&slab).unwrap();
+        assert!(source.open_edges > 0 && !source.flipped);
+        let (lo, hi) = mesh_bounds(&slab);
+        let values = grid_values(&source, &padded_grid(lo, hi, 12).unwrap());
+        assert!(values.iter().all(|&v| v >= 0.0), "a grid point fell inside the slab");
+        assert!(source.encloses_beside_faces());
+        check_encloses(&source, &values).unwrap();
     }
 
     #[test]
