@@ -154,11 +154,8 @@ fn neighbour_inside(tree: &Octree, q: [u32; 3], d: [i32; 3]) -> bool {
         }
         at[a] = c as u32;
     }
-    let node = &tree.nodes[tree.locate(at, super::tree::NONE) as usize];
-    match node.kind {
-        Kind::Empty { inside } => inside,
-        _ => node.value < 0.0,
-    }
+    let node = tree.locate(at, super::tree::NONE);
+    super::dual::inside(tree, super::dual::VertexKey { node, clamp: 0 })
 }
 
 /// The crust vertices that the finest level's contour would wrap in a bubble of their own, moved

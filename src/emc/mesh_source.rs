@@ -80,13 +80,7 @@ impl MeshBvh {
     /// 1/2 on both sides.
     pub fn encloses_beside_faces(&self) -> bool {
         let Some(tree) = &self.winding else { return false };
-        let stride = self.triangles.len().div_ceil(FACE_PROBES).max(1);
-        self.triangles.iter().zip(&self.normals).step_by(stride).any(|(t, &n)| {
-            let [a, b, c] = *t;
-            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-            let centroid = (a + b + c) / 3.0;
-            [-1.0f32, 1.0].iter().any(|&side| tree.winding(centroid + n * (side * 1e-3 * longest)) > 0.5)
-        })
+        beside_faces(&self.triangles).any(|(_, points)| points.iter().any(|&p| tree.winding(p) > 0.5))
     }
 
     /// Indexes the triangles of `mesh`. Triangles without area are left out (no ray can hit them
@@ -140,17 +134,21 @@ impl MeshBvh {
             )));
         }
         let open_edges = open_edges(mesh).len();
-        let flipped = if open_edges > 0 { inside_out_by_winding(&triangles) } else { volume < 0.0 };
+        let mut winding = (open_edges > 0).then(|| WindingTree::new(&triangles));
+        let flipped = match &winding {
+            Some(tree) => inside_out_by_winding(tree, &triangles),
+            None => volume < 0.0,
+        };
         if flipped {
             for t in &mut triangles {
                 t.swap(1, 2);
             }
+            winding = winding.map(|_| WindingTree::new(&triangles));
         }
         let normals =
             triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero()).collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bvh = Bvh::build(&boxes);
-        let winding = (open_edges > 0).then(|| WindingTree::new(&triangles));
         Ok(MeshBvh { triangles, normals, boxes, bvh, degenerate, duplicates, flipped, open_edges, winding })
     }
 
@@ -457,33 +455,35 @@ pub fn grid_values(mesh: &MeshBvh, grid: &Grid) -> Vec<f32> {
     values
 }
 
-/// Whether triangles with holes are wound inside out, by their generalised winding number. Just
-/// behind a face (against its normal) and just in front of it the number is about 1 and 0 where
-/// the faces are wound outward, 0 and -1 where they are wound the other way, holes or not; so the
-/// area-weighted sum of the two over the faces (up to [`FACE_PROBES`] of them) has the winding's
-/// sign. The enclosed volume, which decides for closed meshes, depends on the point it is taken
-/// about once faces are missing: a face missing from a small part far from that point outweighs
-/// the part's whole volume (random shells meshed into specks, a few faces punched out, were
-/// turned inside out and then refused as enclosing nothing).
-fn inside_out_by_winding(triangles: &[[Vec3; 3]]) -> bool {
-    let tree = WindingTree::new(triangles);
-    let stride = triangles.len().div_ceil(FACE_PROBES).max(1);
-    let sum: f64 = triangles
-        .iter()
-        .step_by(stride)
-        .map(|&[a, b, c]| {
-            let cross = (b - a).cross(c - a);
-            let n = cross.normalize_or_zero();
-            let step = 1e-3 * a.distance(b).max(b.distance(c)).max(c.distance(a));
-            let centroid = (a + b + c) / 3.0;
-            let w = tree.winding(centroid - n * step) + tree.winding(centroid + n * step);
-            cross.length() as f64 * w
-        })
+/// Whether triangles with holes are wound inside out, by their generalised winding number (`tree`,
+/// built over them). Just behind a face (against its normal) and just in front of it the number
+/// is about 1 and 0 where the faces are wound outward, 0 and -1 where they are wound the other
+/// way, holes or not; so the area-weighted sum of the two over the faces (those of
+/// [`beside_faces`]) has the winding's sign. The enclosed volume, which decides for closed meshes,
+/// depends on the point it is taken about once faces are missing: a face missing from a small part
+/// far from that point outweighs the part's whole volume (random shells meshed into specks, a few
+/// faces punched out, were turned inside out and then refused as enclosing nothing).
+fn inside_out_by_winding(tree: &WindingTree, triangles: &[[Vec3; 3]]) -> bool {
+    let sum: f64 = beside_faces(triangles)
+        .map(|(area, points)| area as f64 * points.iter().map(|&p| tree.winding(p)).sum::<f64>())
         .sum();
     sum < 0.0
 }
 
-/// Faces [`MeshBvh::encloses_beside_faces`] looks beside at most.
+/// Up to [`FACE_PROBES`] faces spread over `triangles`, each as twice its area and the points a
+/// thousandth of its longest edge off its centroid, behind it (against its normal) and in front.
+fn beside_faces(triangles: &[[Vec3; 3]]) -> impl Iterator<Item = (f32, [Vec3; 2])> + '_ {
+    let stride = triangles.len().div_ceil(FACE_PROBES).max(1);
+    triangles.iter().step_by(stride).map(|&[a, b, c]| {
+        let cross = (b - a).cross(c - a);
+        let off = cross.normalize_or_zero() * (1e-3 * a.distance(b).max(b.distance(c)).max(c.distance(a)));
+        let centroid = (a + b + c) / 3.0;
+        (cross.length(), [centroid - off, centroid + off])
+    })
+}
+
+/// Faces `beside_faces` yields at most: orientation and the sheet test of a mesh with holes cost
+/// two winding numbers each.
 pub const FACE_PROBES: usize = 1024;
 
 /// Refuses the grid values of a mesh with holes where no grid point is inside: an open surface
