@@ -32,6 +32,15 @@ pub trait Field: Sync {
         None
     }
 
+    /// How steep the field typically is, in its units per unit of length (the length of its
+    /// gradient, as a scale): what a distance in world units is multiplied by to be compared
+    /// with the field's values or combined with them. Signed distances, the expression
+    /// language's shapes, are 1; sampled volumes carry their data's own units (CT numbers,
+    /// 16-bit words), often thousands per cell.
+    fn steepness(&self) -> f32 {
+        1.0
+    }
+
     /// Values at many points at once. Evaluators that vectorise override this; grids call it per row.
     fn values(&self, points: &[Vec3], out: &mut [f32]) {
         for (p, o) in points.iter().zip(out.iter_mut()) {
@@ -533,6 +542,33 @@ impl Field for SampledField<'_> {
         y0 + (y1 - y0) * t.z
     }
 
+    /// The mean length of the samples' gradient (forward differences, each sample with a
+    /// neighbour along every axis), 1 where every sample is the same: a signed distance sampled
+    /// is about 1, a 16-bit scan thousands per unit.
+    fn steepness(&self) -> f32 {
+        let [nx, ny, nz] = self.grid.points();
+        let strides = [1, nx, nx * ny];
+        let (mut sum, mut count) = (0.0f64, 0usize);
+        for k in 0..nz.saturating_sub(1) {
+            for j in 0..ny.saturating_sub(1) {
+                for i in 0..nx.saturating_sub(1) {
+                    let n = self.grid.index(i, j, k);
+                    let g = Vec3::from_array(std::array::from_fn(|a| {
+                        self.values[n + strides[a]] - self.values[n]
+                    })) / self.grid.spacing;
+                    sum += g.length() as f64;
+                    count += 1;
+                }
+            }
+        }
+        let mean = (sum / count.max(1) as f64) as f32;
+        if mean.is_finite() && mean > 0.0 {
+            mean
+        } else {
+            1.0
+        }
+    }
+
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         if self.gradient == SampleGradient::CentralDifferences {
             return Some(crate::mc::sample_gradient(self.values, &self.grid, p));
@@ -562,6 +598,22 @@ mod tests {
                 assert!((s.value(p) - f(p)).abs() < 1e-5);
                 assert!((s.gradient(p).unwrap() - Vec3::new(2.0, -3.0, 0.5)).length() < 1e-4, "{gradient:?}");
             }
+        }
+    }
+
+    /// A sampled field's steepness is its gradient's length in its own units (a 16-bit scan's
+    /// thousands per unit, a distance's 1), and 1 where the samples say nothing.
+    #[test]
+    fn sampled_steepness_is_the_gradients_length_in_the_datas_units() {
+        let grid = Grid::new(Vec3::splat(-1.0), Vec3::splat(1.0), [4, 5, 6]).unwrap();
+        for (f, expected) in [
+            (Box::new(|p: Vec3| 3000.0 * p.x - 4000.0 * p.z) as Box<dyn Fn(Vec3) -> f32 + Sync>, 5000.0),
+            (Box::new(|p: Vec3| p.length() - 0.5), 1.0),
+            (Box::new(|_: Vec3| 7.0), 1.0),
+        ] {
+            let values = sample_grid(&f, &grid).unwrap();
+            let s = SampledField { grid, values: &values, gradient: SampleGradient::Trilinear }.steepness();
+            assert!((s - expected).abs() < 0.05 * expected, "{s} against {expected}");
         }
     }
 

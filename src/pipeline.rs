@@ -521,6 +521,9 @@ impl Field for Shifted<'_> {
         let (v, g) = self.field.value_and_gradient(p);
         (v - self.iso, g)
     }
+    fn steepness(&self) -> f32 {
+        self.field.steepness()
+    }
 }
 
 #[cfg(test)]

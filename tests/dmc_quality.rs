@@ -129,8 +129,7 @@ fn every_scene_has_few_slivers_and_no_spikes() {
         let options = DmcOptions { max_depth: 6, ..DmcOptions::default() };
         let (mesh, _) = dmc::mesh_field(scene.field.as_ref(), scene.min, scene.max, &options).unwrap();
         let h = (scene.max - scene.min).max_element() / 64.0;
-        let clipped =
-            dmc::bounds::Clipped { field: scene.field.as_ref(), iso: 0.0, min: scene.min, max: scene.max };
+        let clipped = dmc::bounds::Clipped::new(scene.field.as_ref(), 0.0, scene.min, scene.max);
         let q = common::quality::measure(&mesh, &clipped, h);
         eprintln!(
             "{name}: {} triangles, {:.2} % under 10°, min angle {:.2}°, normal deviation max {:.1}°, {} faces over 20°",

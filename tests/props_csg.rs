@@ -360,7 +360,7 @@ fn check_dmc_quality(case: &Case) {
         .unwrap_or_else(|e| panic!("dmc failed: {e}\n{}", case.describe()));
     let h = (max - min).max_element() / (1u32 << max_depth) as f32;
     // The shape as DMC meshes it: closed by the bounds' faces where it reaches past them.
-    let clipped = dmc::bounds::Clipped { field: &case.program, iso: 0.0, min, max };
+    let clipped = dmc::bounds::Clipped::new(&case.program, 0.0, min, max);
     let q = common::quality::measure(&mesh, &clipped, h);
     eprintln!(
         "seed {}: {} triangles, {:.2} % under 10°, deviation max {:.1}°",

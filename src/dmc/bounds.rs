@@ -17,11 +17,29 @@ pub struct Clipped<'a> {
     pub iso: f32,
     pub min: Vec3,
     pub max: Vec3,
+    /// The box's distance is scaled by the field's [`Field::steepness`], so that the two terms
+    /// are in the same units. Unscaled, a 16-bit volume's solid became, wherever it reached a
+    /// face, a plateau a few units below the level (`iso` minus the distance to the box), flat
+    /// beside the data's thousands per cell: vertices settled on it a hair inside, and untangling
+    /// could not move them off the level (random noise grids crossed themselves). A distance's
+    /// steepness is 1, and the clip of a shape inside the bounds is still the shape itself.
+    pub slope: f32,
 }
 
-impl Clipped<'_> {
-    /// Signed distance to the box (negative inside) and its gradient.
+impl<'a> Clipped<'a> {
+    /// `field` clipped to `[min, max]`, the box scaled by the field's steepness.
+    pub fn new(field: &'a dyn Field, iso: f32, min: Vec3, max: Vec3) -> Clipped<'a> {
+        Clipped { field, iso, min, max, slope: field.steepness() }
+    }
+
+    /// Signed distance to the box (negative inside) and its gradient, in the field's units.
     fn box_distance(&self, p: Vec3) -> (f32, Vec3) {
+        let (d, g) = self.unit_box_distance(p);
+        (d * self.slope, g * self.slope)
+    }
+
+    /// Signed distance to the box (negative inside) and its unit gradient.
+    fn unit_box_distance(&self, p: Vec3) -> (f32, Vec3) {
         let centre = (self.min + self.max) * 0.5;
         let d = p - centre;
         let q = d.abs() - (self.max - self.min) * 0.5;
@@ -46,7 +64,7 @@ impl Clipped<'_> {
         if value.is_finite() || c == p {
             return value.max(self.iso + self.box_distance(p).0);
         }
-        self.field.value(c).max(self.iso) + (p - c).abs().max_element()
+        self.field.value(c).max(self.iso) + (p - c).abs().max_element() * self.slope
     }
 
     /// The clipped gradient at `p` from the field's value and gradient there.
@@ -61,7 +79,7 @@ impl Clipped<'_> {
         let out = p - c;
         let mut away = Vec3::ZERO;
         let axis = largest_axis(out.abs());
-        away[axis] = out[axis].signum();
+        away[axis] = out[axis].signum() * self.slope;
         if self.field.value(c) < self.iso {
             return Some(away);
         }
@@ -85,6 +103,10 @@ impl Field for Clipped<'_> {
         self.combine(self.field.value(p), p)
     }
 
+    fn steepness(&self) -> f32 {
+        self.slope
+    }
+
     fn gradient(&self, p: Vec3) -> Option<Vec3> {
         self.combine_gradient(self.field.value(p), self.field.gradient(p), p)
     }
@@ -106,7 +128,7 @@ impl Field for Clipped<'_> {
         });
         let box_hi = corners.map(|p| self.box_distance(p).0).fold(f32::NEG_INFINITY, f32::max);
         let gap = (lo - self.max).max(self.min - hi).max_element();
-        let low = if gap > 0.0 { flo.max(self.iso + gap) } else { flo };
+        let low = if gap > 0.0 { flo.max(self.iso + gap * self.slope) } else { flo };
         Some((low, fhi.max(self.iso + box_hi)))
     }
 
@@ -145,7 +167,7 @@ mod tests {
                 f32::NAN
             }
         };
-        let clipped = Clipped { field: &field, iso: 0.0, min, max };
+        let clipped = Clipped::new(&field, 0.0, min, max);
         for p in [Vec3::new(0.3, -0.2, 0.9), Vec3::new(0.0, 0.0, 0.1), Vec3::new(0.5, 0.5, 3.0)] {
             assert!((clipped.value(p) - (p.z - 0.2)).abs() < 1e-6, "at {p}");
         }
@@ -153,6 +175,27 @@ mod tests {
         assert!(clipped.value(Vec3::new(0.0, 0.0, -0.4)) < 0.0);
         assert!(clipped.value(Vec3::new(0.0, 0.0, -0.6)) > 0.0);
         assert!(clipped.value(Vec3::new(1.5, 0.0, -0.4)) > 0.0);
+    }
+
+    /// A volume in thousands of units per cell whose solid reaches a face of the bounds keeps its
+    /// own values a little way in from the face, closed on the face itself: the box is scaled to
+    /// the data (unscaled, the solid's inside became a plateau a few units under the level).
+    #[test]
+    fn a_steep_volume_is_clipped_in_its_own_units() {
+        let grid = crate::Grid::new(Vec3::ZERO, Vec3::ONE, [9, 9, 9]).unwrap();
+        let values = crate::field::sample_grid(&|p: Vec3| 1000.0 * (p.x - 0.5), &grid).unwrap();
+        let data = crate::field::SampledField {
+            grid,
+            values: &values,
+            gradient: crate::field::SampleGradient::Trilinear,
+        };
+        let clipped = Clipped::new(&data, 0.0, Vec3::ZERO, Vec3::ONE);
+        // A tenth from the face y = 0, where the data is -300: the box term is -100, the value too.
+        let p = Vec3::new(0.2, 0.1, 0.5);
+        assert!((clipped.value(p) + 100.0).abs() < 1.0, "{}", clipped.value(p));
+        assert!(clipped.value(Vec3::new(0.2, 0.0, 0.5)) >= 0.0);
+        let deep = Vec3::new(0.45, 0.5, 0.5);
+        assert_eq!(clipped.value(deep), data.value(deep));
     }
 
     /// An exact distance whose shape lies inside the bounds is its own clip, values and gradients
@@ -167,7 +210,7 @@ mod tests {
             let grid =
                 crate::dmc::finest_grid(min, max, crate::dmc::DmcOptions::default().max_depth).unwrap();
             let (root, size) = (grid.origin, grid.max() - grid.origin);
-            let clipped = Clipped { field, iso: 0.0, min, max };
+            let clipped = Clipped::new(field, 0.0, min, max);
             let n = 20;
             for i in 0..=n {
                 for j in 0..=n {

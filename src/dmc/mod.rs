@@ -201,7 +201,7 @@ pub fn mesh_field(
     options.validate()?;
     // The bounds' checks (finite, ordered, not degenerate) and the finest cells' size.
     finest_grid(min, max, options.max_depth)?;
-    let clipped = bounds::Clipped { field, iso: options.iso, min, max };
+    let clipped = bounds::Clipped::new(field, options.iso, min, max);
     let field: &dyn Field = &clipped;
     let iso = options.iso;
     let mut stats = DmcStats::default();
