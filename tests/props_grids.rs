@@ -344,9 +344,9 @@ fn prop_dmc_on_samples_is_closed() {
     });
 }
 
-/// DMC crossing- and fold-free on random sampled grids: not kept yet (4 of the first 600 seeds
-/// fail, 7000155, 7000163, 7000423 and 7000514: noise of ±0.2..1 or bytes on cells up to ten
-/// times longer than wide. Where the vertices of the leaves involved are at their finest level
+/// DMC crossing- and fold-free on random sampled grids: not kept yet (3 of the first 600 seeds
+/// fail, 7000155, 7000410 and 7000514: noise of ±0.2..1 on cells up to ten times longer than
+/// wide. Where the vertices of the leaves involved are at their finest level
 /// and may not move to their centres without changing side, `dmc::untangle` has nothing left to
 /// try).
 #[test]
@@ -362,12 +362,31 @@ fn check_dmc_does_not_cross_itself(seed: u64, case: &Case) {
     assert_eq!(analysis::folded_pairs(&mesh), Vec::<[u32; 2]>::new(), "{what}: folds");
 }
 
+/// DMC sees a volume as its distance from the level in units of length (`Field::steepness`), so
+/// the same samples and level in other units (times 1024, exact in floating point) give the
+/// same mesh, vertex for vertex. Before, the clip to the bounds, the QEF's tolerance and the
+/// level band were read in the data's units.
+#[test]
+fn prop_dmc_on_samples_does_not_depend_on_the_datas_units() {
+    for_cases(7_100_000, 10, |seed, case| {
+        let scaled = Case {
+            values: case.values.iter().map(|v| v * 1024.0).collect(),
+            iso: case.iso * 1024.0,
+            ..case.clone()
+        };
+        let (a, b) = (mesh(case, Method::Dmc, Topology::Fixed), mesh(&scaled, Method::Dmc, Topology::Fixed));
+        let what = format!("seed {seed} dmc: {}", case.describe());
+        assert_eq!(a.triangles, b.triangles, "{what}: triangles");
+        assert_eq!(a.positions, b.positions, "{what}: positions");
+    });
+}
+
 /// The seeds of [`prop_dmc_on_samples_does_not_cross_itself`] whose data are 8- and 16-bit
 /// words reaching the grid's border: they crossed themselves (7000085, 10 pairs; 7000329) or
-/// folded (7000213) while DMC's clip to the bounds and its level band were measured in world
-/// units, a distance of a few units beside data of thousands per cell: the solid's inside was a
-/// plateau a hair under the level, and vertices settled on it that untangling could not move.
-/// Both are in the field's units now (`Field::steepness`); 10 of the first 600 seeds failed, 4 do.
+/// folded (7000213) while DMC clipped them to the bounds by a distance in world units, a few
+/// units beside data of thousands per cell: the solid's inside was a plateau a hair under the
+/// level, and vertices settled on it that untangling could not move. DMC sees every field as a
+/// distance from its level now (`Field::steepness`); 10 of the first 600 seeds failed, 3 do.
 #[test]
 fn dmc_on_words_reaching_the_border_does_not_cross_itself() {
     for seed in [7_000_085, 7_000_213, 7_000_329] {

@@ -255,8 +255,7 @@ pub fn settle_vertices(
 ) -> Vec<f32> {
     let mut at = vec![0.0; vertices.len()];
     field.values(vertices, &mut at);
-    // In the field's units: a 16-bit volume's values near the level are thousands per cell.
-    let band = LEVEL_BAND * h * field.steepness();
+    let band = LEVEL_BAND * h;
     let near: Vec<usize> = (0..at.len())
         .filter(|&i| (at[i] - iso).abs() <= if free[i] { band } else { band * STOPPED_BAND })
         .collect();
@@ -274,8 +273,8 @@ pub fn settle_vertices(
     at.iter().map(|v| v - iso).collect()
 }
 
-/// Vertices this close to the level (fraction of a finest cell, as a distance: the field's
-/// value over its [`Field::steepness`]) take their leaf centre's side.
+/// Vertices this close to the level (fraction of a finest cell; DMC sees every field in units of
+/// length, see [`super::bounds::Clipped`]) take their leaf centre's side.
 pub const LEVEL_BAND: f32 = 1e-4;
 
 /// How many times wider that band is for vertices stopped on their leaf's boundary.

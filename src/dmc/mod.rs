@@ -203,7 +203,8 @@ pub fn mesh_field(
     finest_grid(min, max, options.max_depth)?;
     let clipped = bounds::Clipped::new(field, options.iso, min, max);
     let field: &dyn Field = &clipped;
-    let iso = options.iso;
+    // The clipped field is the distance from `options.iso`: its level is 0.
+    let iso = 0.0;
     let mut stats = DmcStats::default();
 
     crate::progress::checkpoint("octree", 0.0)?;
