@@ -234,9 +234,23 @@ pub fn triangulate_polygon(poly: &[u8]) -> Vec<[u8; 3]> {
 }
 
 fn triangulate(polygons: &CellPolygons) -> CellTriangles {
+    triangulate_with(polygons, triangulate_polygon)
+}
+
+/// [`triangulate_polygon`], or where that needs a [`CENTER`] vertex, a fan from the polygon's
+/// first vertex: for cells that are not cubes, where a centre would lie on no edge.
+fn triangulate_polygon_without_centre(poly: &[u8]) -> Vec<[u8; 3]> {
+    let tris = triangulate_polygon(poly);
+    if !tris.iter().any(|t| t.contains(&CENTER)) {
+        return tris;
+    }
+    (1..poly.len() - 1).map(|k| [poly[0], poly[k], poly[k + 1]]).collect()
+}
+
+fn triangulate_with(polygons: &CellPolygons, polygon: fn(&[u8]) -> Vec<[u8; 3]>) -> CellTriangles {
     let mut out = CellTriangles { edges: [0; 36], count: 0, per_polygon: [0; 4] };
     for (p, poly) in polygons.iter().enumerate() {
-        for tri in triangulate_polygon(poly) {
+        for tri in polygon(poly) {
             let at = 3 * out.count as usize;
             out.edges[at..at + 3].copy_from_slice(&tri);
             out.count += 1;
@@ -270,6 +284,19 @@ pub fn polygon_table_with_faces() -> &'static [CellPolygons] {
 pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
     TABLE.get_or_init(|| polygon_table_with_faces().iter().map(triangulate).collect())
+}
+
+/// [`triangle_table_with_faces`] with no [`CENTER`] vertex (see
+/// [`triangulate_polygon_without_centre`]): Dual Marching Cubes' cells, whose every mesh vertex
+/// lies on a dual edge.
+pub fn triangle_table_with_faces_without_centre() -> &'static [CellTriangles] {
+    static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        polygon_table_with_faces()
+            .iter()
+            .map(|p| triangulate_with(p, triangulate_polygon_without_centre))
+            .collect()
+    })
 }
 
 #[cfg(test)]

@@ -1,9 +1,10 @@
 //! Contouring the dual grid (§4): Marching Cubes on every dual cell, with the cell's eight vertices
 //! (positions and values) standing in for a cube's corners.
 //!
-//! - The case comes from the signs alone and uses the crate's default table (ambiguous faces always
-//!   separate the inside corners). Two dual cells sharing a face see the same four vertices in the
-//!   same roles, so they agree on that face and the output is crack-free.
+//! - The case comes from the signs, and an ambiguous face joins its inside corners where the field
+//!   at its centre is inside ([`super::faces`]; the default table separates them). Two dual cells
+//!   sharing a face see the same four vertices in the same roles, so they agree on that face and
+//!   the output is crack-free.
 //! - A crossing is keyed by the pair of dual vertices it lies between, so every dual cell using that
 //!   dual edge reuses the same mesh vertex: the mesh is indexed from the start, never welded.
 //! - Adaptive cells repeat vertices. A repeated vertex pair has equal values (no crossing), and two
@@ -20,7 +21,7 @@ use super::dual::{on_side, VertexKey};
 use super::tree::{Kind, Octree};
 use crate::field::Field;
 use crate::mesh::Mesh;
-use crate::tables::{triangle_table, CENTER, EDGES};
+use crate::tables::{triangle_table_with_faces_without_centre, CENTER, EDGES};
 use glam::Vec3;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -28,6 +29,8 @@ use rustc_hash::FxHashMap as HashMap;
 #[derive(Debug, Default)]
 pub struct DualVertices {
     pub positions: Vec<Vec3>,
+    /// Per vertex its leaf's centre ([`super::dual::centre`]), where ambiguous faces are decided.
+    pub centres: Vec<Vec3>,
     pub values: Vec<f32>,
     pub inside: Vec<bool>,
     ids: HashMap<VertexKey, u32>,
@@ -49,6 +52,7 @@ impl DualVertices {
             self.unknown.push(id);
         }
         self.positions.push(p);
+        self.centres.push(super::dual::centre(tree, key));
         self.values.push(node.value);
         self.inside.push(super::dual::inside(tree, key));
         self.ids.insert(key, id);
@@ -102,7 +106,7 @@ pub fn contour(
     iso: f32,
     cache: &mut RootCache,
 ) -> Contour {
-    let table = triangle_table();
+    let table = triangle_table_with_faces_without_centre();
     let mut out = Contour::default();
     let mut edges: HashMap<(u32, u32), u32> = HashMap::default();
     for (c, ids) in cells.iter().enumerate() {
@@ -113,10 +117,12 @@ pub fn contour(
         if case == 0 || case == 255 {
             continue;
         }
-        let tris = &table[case as usize];
+        let centres = ids.map(|id| vertices.centres[id as usize]);
+        let joined = super::faces::joined_faces(case, &centres, field, iso);
+        let tris = &table[(case as usize) << 6 | joined as usize];
         let mut local = [u32::MAX; 12];
         for t in tris.triangles() {
-            debug_assert!(!t.contains(&CENTER), "the default table needs no centre vertex");
+            debug_assert!(!t.contains(&CENTER), "the table has no centre vertex");
             let v = t.map(|e| {
                 let e = e as usize;
                 if local[e] == u32::MAX {

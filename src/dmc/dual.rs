@@ -97,7 +97,18 @@ pub fn inside(tree: &Octree, key: VertexKey) -> bool {
 
 /// Where the vertex of `key` lies: its leaf's, projected onto the grid's faces it is clamped to.
 pub fn position(tree: &Octree, key: VertexKey) -> glam::Vec3 {
-    let mut p = tree.nodes[key.node as usize].vertex;
+    project(tree, key, tree.nodes[key.node as usize].vertex)
+}
+
+/// The centre of `key`'s leaf, projected like [`position`]: where the dual grid's vertex would be
+/// if every vertex sat at its leaf's centre, which depends on the octree alone.
+pub fn centre(tree: &Octree, key: VertexKey) -> glam::Vec3 {
+    let (lo, hi) = tree.world_box(key.node);
+    project(tree, key, (lo + hi) * 0.5)
+}
+
+/// `p` projected onto the grid's faces `key` is clamped to.
+fn project(tree: &Octree, key: VertexKey, mut p: glam::Vec3) -> glam::Vec3 {
     let grid_hi = tree.point(tree.cells);
     for a in 0..3 {
         match key.side(a) {

@@ -12,7 +12,8 @@
 //!   tolerance, [`safety`] proves the contour's topology unchanged and [`fidelity`] finds the
 //!   merged triangles within the tolerance of the surface.
 //! - [`dual`]: the dual cells, one per octree vertex, the grid's boundary included.
-//! - [`contour`]: Marching Cubes on the dual cells, crossings by root finding per dual edge.
+//! - [`contour`]: Marching Cubes on the dual cells, crossings by root finding per dual edge,
+//!   ambiguous faces decided by the field at their centres ([`faces`]).
 //! - [`slivers`]: crossings within a tenth of a cell of a dual vertex moved onto it, the slivers
 //!   between them dropped; then the slivers, spikes and specks left removed by checked edge
 //!   collapses and flips (no vertex moves off the surface, the topology is kept).
@@ -37,6 +38,7 @@ pub mod bounds;
 pub mod build;
 pub mod contour;
 pub mod dual;
+pub mod faces;
 pub mod fidelity;
 pub mod qef;
 pub mod safety;

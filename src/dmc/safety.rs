@@ -4,7 +4,8 @@
 //! A merge changes only the dual cells that have a child (afterwards: the node) among their eight
 //! leaves: the *star* of the merge, the dual cells at the octree vertices in the node's closed box.
 //! The star's outer faces are made of other leaves only, so the contour crosses them in the same
-//! curves before and after (the case table decides a face from its four signs alone). If the
+//! curves before and after (the case table decides a face from its four signs and, where they are
+//! ambiguous, the field at the centre of its four leaves: [`super::faces`]). If the
 //! contour inside the star is, before and after, a set of discs each bounded by exactly one of
 //! those curves, then the two are homeomorphic relative to the curves, and gluing the unchanged
 //! rest of the contour back gives a surface homeomorphic to the one before: same components, same
@@ -20,7 +21,8 @@
 
 use super::dual::{self, dual_cell_by, VertexKey};
 use super::tree::{Kind, Octree, NONE};
-use crate::tables::{triangle_table, EDGES};
+use crate::field::Field;
+use crate::tables::{triangle_table_with_faces_without_centre, EDGES};
 use rustc_hash::FxHashMap as HashMap;
 
 /// A triangle of the contour named by its three dual edges (inside end, outside end).
@@ -28,7 +30,13 @@ pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
 
 /// Whether making internal node `n` (whose children are all leaves) a leaf whose vertex has value
 /// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
-pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriangle>> {
+pub fn merge_is_safe(
+    tree: &Octree,
+    n: u32,
+    value: f32,
+    field: &dyn Field,
+    iso: f32,
+) -> Option<Vec<EdgeTriangle>> {
     let around = Neighbourhood::of(tree, n);
     // The star's points before the merge: the children's corners and the neighbours' corners on
     // the node's closed box. After it, the children's corners that are neither the node's own nor
@@ -54,9 +62,12 @@ pub fn merge_is_safe(tree: &Octree, n: u32, value: f32) -> Option<Vec<EdgeTriang
     let sign_before = |k: VertexKey| dual::inside(tree, k);
     let sign_after =
         |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
+    let joined = |cell: &[VertexKey; 8], case: u8| {
+        super::faces::joined_faces(case, &cell.map(|k| dual::centre(tree, k)), field, iso)
+    };
     let mut crossings = Crossings::default();
-    let tris_before = star_triangles(&cells_before, &sign_before, &mut crossings);
-    let tris_after = star_triangles(&cells_after, &sign_after, &mut crossings);
+    let tris_before = star_triangles(&cells_before, &sign_before, &joined, &mut crossings);
+    let tris_after = star_triangles(&cells_after, &sign_after, &joined, &mut crossings);
     let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
         let mut by_id =
             vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
@@ -240,9 +251,10 @@ impl Crossings {
 fn star_triangles(
     cells: &[[VertexKey; 8]],
     inside: &dyn Fn(VertexKey) -> bool,
+    joined: &dyn Fn(&[VertexKey; 8], u8) -> u8,
     crossings: &mut Crossings,
 ) -> Vec<[u32; 3]> {
-    let table = triangle_table();
+    let table = triangle_table_with_faces_without_centre();
     let mut out = Vec::new();
     for cell in cells {
         let signs = cell.map(inside);
@@ -250,7 +262,7 @@ fn star_triangles(
         if case == 0 || case == 255 {
             continue;
         }
-        for t in table[case as usize].triangles() {
+        for t in table[(case as usize) << 6 | joined(cell, case) as usize].triangles() {
             let v = t.map(|e| {
                 let [a, b] = EDGES[e as usize].map(|corner| corner as usize);
                 let edge = if signs[a] { (cell[a], cell[b]) } else { (cell[b], cell[a]) };

@@ -160,7 +160,7 @@ pub fn simplify(
                 let tree = &*tree;
                 crate::par::map(members.len(), |k| {
                     let i = members[k];
-                    merge_is_safe(tree, candidates[i].node, values[i])
+                    merge_is_safe(tree, candidates[i].node, values[i], field, iso)
                 })
             };
             let mut safe = Vec::new();
