@@ -286,9 +286,9 @@ pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
     TABLE.get_or_init(|| polygon_table_with_faces().iter().map(triangulate).collect())
 }
 
-/// [`triangle_table_with_faces`] with no [`CENTER`] vertex (see
-/// [`triangulate_polygon_without_centre`]): Dual Marching Cubes' cells, whose every mesh vertex
-/// lies on a dual edge.
+/// [`triangle_table_with_faces`] with no [`CENTER`] vertex (a polygon that would need one is fanned
+/// from its first vertex): Dual Marching Cubes' cells, whose every mesh vertex lies on a dual
+/// edge.
 pub fn triangle_table_with_faces_without_centre() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
     TABLE.get_or_init(|| {
