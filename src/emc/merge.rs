@@ -169,9 +169,6 @@ pub fn weld_facing_centres(
     welded
 }
 
-/// Where two centres kept [`INSET`] off either side of one grid plane (the grid's origin and
-/// spacing in `grid`) meet in it: their midpoint, put on the plane; `None` unless they differ along
-/// one axis alone (to a millionth of the spacing), by at most 2.25 insets there, across a plane.
 /// Whether a weld's triangles around the welded vertex (ids and corners, the vertex at its new
 /// place) would cross a triangle near them other than those in `skip` (the ones they replace and
 /// the two the weld drops), or one another.
@@ -188,6 +185,9 @@ fn weld_crosses(
         })
 }
 
+/// Where two centres kept [`INSET`] off either side of one grid plane (the grid's origin and
+/// spacing in `grid`) meet in it: their midpoint, put on the plane; `None` unless they differ along
+/// one axis alone (to a millionth of the spacing), by at most 2.25 insets there, across a plane.
 fn across_one_grid_plane(p1: Vec3, p2: Vec3, (origin, spacing): (Vec3, Vec3)) -> Option<Vec3> {
     let d = (p2 - p1).abs();
     let axis = d.max_position();
