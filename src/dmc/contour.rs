@@ -117,8 +117,7 @@ pub fn contour(
         if case == 0 || case == 255 {
             continue;
         }
-        let centres = ids.map(|id| vertices.centres[id as usize]);
-        let joined = super::faces::joined_faces(case, &centres, field, iso);
+        let joined = super::faces::joined_faces(case, |k| vertices.centres[ids[k] as usize], field, iso);
         let tris = &table[(case as usize) << 6 | joined as usize];
         let mut local = [u32::MAX; 12];
         for t in tris.triangles() {

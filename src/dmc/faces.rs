@@ -25,16 +25,18 @@ use crate::tables::{face_is_ambiguous, FACES};
 use glam::Vec3;
 
 /// The bits (face `f` at bit `f`, [`FACES`]' numbering) of the ambiguous faces of a dual cell of
-/// MC case `case`, whose corners' leaf centres are `corners`, that join their inside corners:
-/// where the field at the face's centre is below `iso`. A face whose two inside or two outside
-/// corners are one leaf (a degenerate cell of an adaptive octree) keeps the default, separated.
-pub fn joined_faces(case: u8, corners: &[Vec3; 8], field: &dyn Field, iso: f32) -> u8 {
+/// MC case `case` that join their inside corners: where the field at the face's centre is below
+/// `iso`. `corner(k)` is the leaf centre of the cell's corner `k`, asked for the corners of
+/// ambiguous faces only (most cells have none, and the safety test asks for every cell of a
+/// star). A face whose two inside or two outside corners are one leaf (a degenerate cell of an
+/// adaptive octree) keeps the default, separated.
+pub fn joined_faces(case: u8, corner: impl Fn(usize) -> Vec3, field: &dyn Field, iso: f32) -> u8 {
     let mut bits = 0;
     for (f, face) in FACES.iter().enumerate() {
         if !face_is_ambiguous(case, f) {
             continue;
         }
-        let [a, b, c, d] = face.map(|k| corners[k as usize]);
+        let [a, b, c, d] = face.map(|k| corner(k as usize));
         if a == c || b == d {
             continue;
         }
@@ -73,8 +75,8 @@ mod tests {
         let corners = cube_with(Vec3::ONE);
         let solid_at_centre = |p: Vec3| (p - Vec3::new(1.0, 0.5, 0.5)).length() - 0.1;
         let air_at_centre = |p: Vec3| 0.1 - (p - Vec3::new(1.0, 0.5, 0.5)).length();
-        assert_eq!(joined_faces(case, &corners, &solid_at_centre, 0.0) & 0b10, 0b10);
-        assert_eq!(joined_faces(case, &corners, &air_at_centre, 0.0) & 0b10, 0);
+        assert_eq!(joined_faces(case, |k| corners[k], &solid_at_centre, 0.0) & 0b10, 0b10);
+        assert_eq!(joined_faces(case, |k| corners[k], &air_at_centre, 0.0) & 0b10, 0);
     }
 
     #[test]
@@ -82,7 +84,7 @@ mod tests {
         let case = (1u8 << 1) | (1 << 7);
         let corners = cube_with(Vec3::new(1.0, 0.0, 0.0));
         let solid = |_: Vec3| -1.0;
-        assert_eq!(joined_faces(case, &corners, &solid, 0.0) & 0b10, 0);
+        assert_eq!(joined_faces(case, |k| corners[k], &solid, 0.0) & 0b10, 0);
     }
 
     #[test]

@@ -63,7 +63,7 @@ pub fn merge_is_safe(
     let sign_after =
         |k: VertexKey| if k.node == n { k.clamp == 0 && value < 0.0 } else { dual::inside(tree, k) };
     let joined = |cell: &[VertexKey; 8], case: u8| {
-        super::faces::joined_faces(case, &cell.map(|k| dual::centre(tree, k)), field, iso)
+        super::faces::joined_faces(case, |k| dual::centre(tree, cell[k]), field, iso)
     };
     let mut crossings = Crossings::default();
     let tris_before = star_triangles(&cells_before, &sign_before, &joined, &mut crossings);

@@ -92,16 +92,17 @@ pub fn move_toward_centres(
         let centre = origin + ((lo + hi) * 0.5 - origin) * step;
         let inside = node.value < 0.0;
         let same = |p: Vec3| (field.value(p) - iso < 0.0) == inside;
-        if !same(centre) && moves[n as usize] as usize == STEPS.len() {
+        let at_centre = field.value(centre) - iso;
+        let centre_same = (at_centre < 0.0) == inside;
+        if !centre_same && moves[n as usize] as usize == STEPS.len() {
             // The last move of a vertex whose centre is on the other side: it takes the centre's
             // side, at the centre (see the module docs, "the last resort").
-            let value = field.value(centre) - iso;
             let node = &mut tree.nodes[n as usize];
             node.vertex = centre;
-            node.value = super::dual::on_side(value, value < 0.0);
+            node.value = super::dual::on_side(at_centre, at_centre < 0.0);
             continue;
         }
-        let target = if same(centre) {
+        let target = if centre_same {
             centre
         } else {
             // The farthest point toward the centre still on the vertex's side.
