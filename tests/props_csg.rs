@@ -45,6 +45,11 @@ impl Case {
         Case { seed, tree, program, res }
     }
 
+    /// The same tree meshed at `res` cells.
+    fn at(&self, res: usize) -> Case {
+        Case { res, seed: self.seed, tree: self.tree.clone(), program: self.program.clone() }
+    }
+
     fn describe(&self) -> String {
         format!(
             "seed {}, res {}, {} primitives: {}",
@@ -315,18 +320,16 @@ fn prop_dmc_keeps_fine_mcs_topology() {
 /// cells, two pieces at 128, one at 256). `None` where the grid does not resolve the tree.
 fn resolved_fine_mc(case: &Case) -> Option<(Output, usize)> {
     let finest = case.res.next_power_of_two();
-    let at =
-        |res: usize| Case { res, seed: case.seed, tree: case.tree.clone(), program: case.program.clone() };
-    let fine = at(finest).mesh(Method::Mc, Topology::Fixed);
+    let fine = case.at(finest).mesh(Method::Mc, Topology::Fixed);
     let shift = Vec3::splat(2.0 / finest as f32 / 3.0);
-    let moved = at(finest).mesh_in(Method::Mc, (Vec3::splat(-1.0) + shift, Vec3::splat(1.0) + shift));
+    let moved = case.at(finest).mesh_in(Method::Mc, (Vec3::splat(-1.0) + shift, Vec3::splat(1.0) + shift));
     let topology = |mc: &Output| (mc.stats.euler, mc.stats.components);
     let resolved = mc_closed(&fine)
         && mc_closed(&moved)
         && topology(&fine) == topology(&moved)
         && [2, 4]
             .iter()
-            .all(|k| topology(&fine) == topology(&at(k * finest).mesh(Method::Mc, Topology::Fixed)));
+            .all(|k| topology(&fine) == topology(&case.at(k * finest).mesh(Method::Mc, Topology::Fixed)));
     resolved.then_some((fine, finest))
 }
 
@@ -442,8 +445,7 @@ fn dmc_at_16_cells_has_the_topology_that_mc_needs_64_for_on_seed_8500047() {
     assert_eq!(case.res, 16, "the case: {}", case.describe());
     assert!(resolved_fine_mc(&case).is_none(), "{}", case.describe());
     let mc_at = |res: usize| {
-        let mc = Case { res, seed: case.seed, tree: case.tree.clone(), program: case.program.clone() }
-            .mesh(Method::Mc, Topology::Fixed);
+        let mc = case.at(res).mesh(Method::Mc, Topology::Fixed);
         (mc.stats.euler, mc.stats.components)
     };
     let truth = mc_at(64);
