@@ -151,6 +151,17 @@ fn holed_specks_far_apart_keep_their_winding_on_seed_8500046() {
     check_holed_remesh(8_500_046);
 }
 
+/// Open, found by a soak past CI's seeds (seeds 8500024–8500200): a few triangles punched out
+/// of a random tree's mesh, spanned by the winding number, remesh with another topology than the
+/// closed mesh: seed 8500107 by MC ((4, 3) for (6, 3): Euler characteristic, components), 8500142
+/// by DMC ((10, 5) for (8, 4)). Ignored until looked into.
+#[test]
+#[ignore]
+fn holed_meshes_keep_their_topology_on_seeds_8500107_8500142() {
+    check_holed_remesh(8_500_107);
+    check_holed_remesh(8_500_142);
+}
+
 fn check_holed_remesh(seed: u64) {
     let mut rng = Rng::new(seed);
     // Holes in a surface, not most of it gone: five faces punched out of a speck of eight
@@ -236,47 +247,63 @@ fn prop_meshes_remesh_closed_with_mcs_topology() {
 #[test]
 fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
     for seed in case_seeds(6_500_000, CI_CASES) {
-        let mut rng = Rng::new(seed);
-        let (source, text) = source_mesh(&mut rng, 40);
-        let program = expr::compile(&text).unwrap();
-        let normals: Vec<Vec3> = source
-            .positions
-            .iter()
-            .map(|&p| program.gradient(p).unwrap_or(Vec3::Z).normalize_or(Vec3::Z))
-            .collect();
-        let cloud = PointCloud { positions: source.positions.clone(), normals };
-        // The normals are exact: orientation may turn a few where parts are thinner than the
-        // samples' spacing (the two faces of a shell thinning to nothing read as flipped where
-        // they meet), never a face. Measured over 100 trees: none in 86, at most 1.9 % of a cloud
-        // of 748 (and 48 of a 232-sample speck, not asserted).
-        let mut oriented = cloud.clone();
-        let turned = isoforge::emc::orient::orient_normals(&mut oriented)
-            .unwrap_or_else(|e| panic!("seed {seed}: exact normals refused: {e}"));
-        if cloud.len() >= 500 {
-            assert!(
-                turned * 33 <= cloud.len(),
-                "seed {seed}: {turned} of {} exact normals turned",
-                cloud.len()
-            );
-        }
-        let res = 12 + rng.below(12) as usize;
-        let what = format!("seed {seed}, res {res}, {} points of {text}", cloud.positions.len());
-        let mc = pipeline::mesh_points(&cloud, &bare_request(Method::Mc, res))
-            .unwrap_or_else(|e| panic!("{what}: mc refused it: {e}"));
-        let emc = pipeline::mesh_points(&cloud, &bare_request(Method::Emc, res))
-            .unwrap_or_else(|e| panic!("{what}: emc refused it: {e}"));
-        let (lo, hi) = cloud.bounds();
-        let grid = padded_grid(lo, hi, res).unwrap();
-        let mc_topo = assert_open_only_on_the_grid(&mc, &grid, &format!("mc, {what}"));
-        let emc_topo = assert_open_only_on_the_grid(&emc, &grid, &format!("emc, {what}"));
-        assert_eq!(mc_topo.boundary_edges, 0, "mc, {what}: open");
-        assert_eq!(emc_topo.boundary_edges, 0, "emc, {what}: open");
-        assert_eq!(
-            (emc_topo.euler, emc_topo.components),
-            (mc_topo.euler, mc_topo.components),
-            "emc vs mc, {what}"
-        );
+        check_point_cloud(seed);
     }
+}
+
+/// Open, found by a soak past CI's seeds (`ISOFORGE_SEED=S` over seeds 6500048–6500399): where a
+/// tree has parts thinner than the samples' spacing, orientation turns many of its exact normals
+/// (seed 6500218: 152 of 958, 6500244: 633 of 1 574, 6500326: 3 173 of 9 976) or refuses a part
+/// as unorientable (6500192: 84 of 580 samples, 53 % of their neighbouring normals disagreeing).
+/// Both sheets of a thin part lie in each other's tangent planes with opposite normals, which
+/// reads as flipped; docs/inputs.md says so. Ignored until orientation tells a thin part from a
+/// flipped patch.
+#[test]
+#[ignore]
+fn exact_normals_of_thin_parts_are_kept_on_seeds_6500192_6500218_6500244_6500326() {
+    for seed in [6_500_192, 6_500_218, 6_500_244, 6_500_326] {
+        check_point_cloud(seed);
+    }
+}
+
+fn check_point_cloud(seed: u64) {
+    let mut rng = Rng::new(seed);
+    let (source, text) = source_mesh(&mut rng, 40);
+    let program = expr::compile(&text).unwrap();
+    let normals: Vec<Vec3> = source
+        .positions
+        .iter()
+        .map(|&p| program.gradient(p).unwrap_or(Vec3::Z).normalize_or(Vec3::Z))
+        .collect();
+    let cloud = PointCloud { positions: source.positions.clone(), normals };
+    // The normals are exact: orientation may turn a few where parts are thinner than the
+    // samples' spacing (the two faces of a shell thinning to nothing read as flipped where
+    // they meet), never a face. Measured over 100 trees: none in 86, at most 1.9 % of a cloud
+    // of 748 (and 48 of a 232-sample speck, not asserted); over seeds 48-399, four trees with
+    // thin parts break this (the ignored test above).
+    let mut oriented = cloud.clone();
+    let turned = isoforge::emc::orient::orient_normals(&mut oriented)
+        .unwrap_or_else(|e| panic!("seed {seed}: exact normals refused: {e}"));
+    if cloud.len() >= 500 {
+        assert!(turned * 33 <= cloud.len(), "seed {seed}: {turned} of {} exact normals turned", cloud.len());
+    }
+    let res = 12 + rng.below(12) as usize;
+    let what = format!("seed {seed}, res {res}, {} points of {text}", cloud.positions.len());
+    let mc = pipeline::mesh_points(&cloud, &bare_request(Method::Mc, res))
+        .unwrap_or_else(|e| panic!("{what}: mc refused it: {e}"));
+    let emc = pipeline::mesh_points(&cloud, &bare_request(Method::Emc, res))
+        .unwrap_or_else(|e| panic!("{what}: emc refused it: {e}"));
+    let (lo, hi) = cloud.bounds();
+    let grid = padded_grid(lo, hi, res).unwrap();
+    let mc_topo = assert_open_only_on_the_grid(&mc, &grid, &format!("mc, {what}"));
+    let emc_topo = assert_open_only_on_the_grid(&emc, &grid, &format!("emc, {what}"));
+    assert_eq!(mc_topo.boundary_edges, 0, "mc, {what}: open");
+    assert_eq!(emc_topo.boundary_edges, 0, "emc, {what}: open");
+    assert_eq!(
+        (emc_topo.euler, emc_topo.components),
+        (mc_topo.euler, mc_topo.components),
+        "emc vs mc, {what}"
+    );
 }
 
 /// A convex part of a random shape: a ball or a box turned at random.
