@@ -59,6 +59,10 @@ const DISORDER: f64 = 0.3;
 /// than refused: a handful of stray samples cannot make the whole cloud unusable.
 const SIZEABLE: f64 = 0.01;
 
+/// The least offset (as in [`agreement`]) at which two points each behind the other's plane are
+/// read as a wall's two faces: 0.6°, far above rounding on a flat sheet.
+const THIN_WALL: f32 = 0.01;
+
 /// How strongly samples `i` (at `pi`, normal `ni`) and `j` agree that their normals point to the
 /// same side of the surface, in −1..1, and whether that rests on the normals alone (the two lie
 /// on one smooth sheet).
@@ -80,7 +84,9 @@ const SIZEABLE: f64 = 0.01;
 /// Where the normals are (anti)parallel (`|ni·nj| ≥ 0.5`) but the points lie off each other's
 /// planes, the two tests can contradict each other and neither is reliable: a step (a convex edge
 /// and a concave one) with consistent normals reads as flipped to the second test, the two faces
-/// of a wall thinner than the neighbourhood read as flipped to the first. Such a pair has no vote.
+/// of a wall thinner than the neighbourhood read as flipped to the first. Such a pair has no vote,
+/// and neither has a pair with opposite normals each behind the other's plane by more than
+/// 0.01 (`THIN_WALL`), however near the planes: a wall's two faces.
 pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> (f32, bool) {
     let parallel = ni.dot(nj);
     let d = pj - pi;
@@ -92,6 +98,12 @@ pub fn agreement(pi: Vec3, ni: Vec3, pj: Vec3, nj: Vec3) -> (f32, bool) {
     let offset = ai.abs().min(aj.abs());
     let w = ((offset - 0.05) / 0.15).clamp(0.0, 1.0);
     if w == 0.0 {
+        // Opposite normals on points each behind the other's plane: the two faces of a wall
+        // thinner than the neighbourhood however thin (a flipped normal on one curved sheet puts
+        // the two on opposite sides of each other's planes).
+        if parallel <= -0.5 && ai < -THIN_WALL && aj < -THIN_WALL {
+            return (0.0, false);
+        }
         return (parallel, true);
     }
     let sides = if ai * aj > 0.0 { 1.0 } else { -1.0 };
