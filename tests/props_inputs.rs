@@ -253,9 +253,11 @@ fn prop_point_clouds_reconstruct_closed_with_mcs_topology() {
 
 /// Open, found by a soak past CI's seeds (`ISOFORGE_SEED=S` over seeds 6500048–6500399): where a
 /// tree has parts thinner than the samples' spacing, orientation turns many of its exact normals
-/// (seed 6500218: 152 of 958, 6500244: 633 of 1 574, 6500326: 3 173 of 9 976). Both sheets of a
-/// thin part lie in each other's tangent planes with opposite normals, which reads as flipped;
-/// docs/inputs.md says so. Ignored until orientation tells a thin part from a flipped patch.
+/// (seed 6500218: 152 of 958, 6500244: 633 of 1 574, 6500326: 3 173 of 9 976): pairs across
+/// edges next to a thin part put each sample on another side of the other's plane, and pairs
+/// 134° apart with one sample within 1° of the other's plane vote as one sheet with a normal
+/// flipped (6500218). docs/inputs.md says so. Ignored until orientation tells a thin part from a
+/// flipped patch.
 #[test]
 #[ignore]
 fn exact_normals_of_thin_parts_are_kept_on_seeds_6500218_6500244_6500326() {
