@@ -338,11 +338,12 @@ fn decimation_to_a_tenth_leaves_few_slivers() {
     }
 }
 
-/// The gear at 64 cells, whose teeth's short creases leave EMC with 6.1 % of its triangles under
-/// 10°: decimation's sliver passes alone (a target above its count: sliver edges collapsed, free
-/// vertices moved, flat pairs flipped; no feature point moves) take it under 2 % (0.6 %; 0.9 %
-/// before free vertices moved), no sample of it farther from the surface than EMC's. Decimated to
-/// a tenth it keeps 6.4 %: the slivers left there lie between vertices of its feature lines.
+/// The gear at 64 cells, whose teeth's short creases leave EMC with 5.3 % of its triangles under
+/// 10° (6.1 % when this was written): decimation's sliver passes alone (a target above its count:
+/// sliver edges collapsed, free vertices moved, flat pairs flipped; no feature point moves) take
+/// it under 2 % (0.02 % today; 0.9 % before free vertices moved), no sample of it farther from the
+/// surface than EMC's. Decimated towards a tenth it keeps 3.3 %: the slivers left there lie
+/// between vertices of its feature lines (docs/decimate.md, Limits).
 #[test]
 #[cfg_attr(target_arch = "wasm32", ignore)]
 fn the_gears_slivers_go_with_decimations_sliver_passes() {
