@@ -236,7 +236,8 @@ fn random_smooth_solids_have_no_feature_points() {
 /// beside the plane put a fan centre on the apex and fan the polygon edge they share in the
 /// plane. No two faces may fold onto each other there (two faces 88° off lay in the plane, back
 /// to back, a fin, until the two centres were welded into one on it: 6 of these 12 seeds had
-/// one). Faces near the apex may still lean: the cavity is thinner than a cell there.
+/// one; see docs/emc.md for a soak of 61). Faces near the apex may still lean: the cavity is
+/// thinner than a cell there.
 #[test]
 fn cone_apexes_in_grid_planes_leave_no_fins() {
     for seed in case_seeds(18_200, 12) {
@@ -244,31 +245,59 @@ fn cone_apexes_in_grid_planes_leave_no_fins() {
             // Open: see `cone_apex_in_a_grid_plane_seen_by_a_third_cell` below.
             continue;
         }
-        let mut rng = Rng::new(seed);
-        let res = [32, 64, 128][rng.below(3) as usize];
-        let radius = rng.range(0.2, 0.35);
-        let z = (rng.below(5) as f32 - 2.0) / 8.0;
-        let y = rng.range(-0.3, 0.3);
-        let text = format!(
-            "subtract(box(0.6, 0.6, 0.6), translate(rotate(cone({radius}, {radius}), 0, 1, 0, 90), -0.65, {y}, {z}))"
-        );
-        let field = expr::compile(&text).unwrap();
-        let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res).unwrap();
-        let out = emc_on(&field, &grid, &EmcOptions::default());
-        // Faces lying in the plane (all three corners within a twentieth of a cell of it) next to
-        // the apex: the cone crosses the plane at right angles there.
-        let h = grid.cell_size();
-        let apex = Vec3::new(-0.65 + radius, y, z);
-        let flat: Vec<[Vec3; 3]> = out
-            .mesh
-            .triangles
-            .iter()
-            .map(|t| t.map(|v| out.mesh.positions[v as usize]))
-            .filter(|c| c.iter().all(|p| (p.z - z).abs() < 0.05 * h && p.distance(apex) < 1.5 * h))
-            .filter(|c| (c[1] - c[0]).cross(c[2] - c[0]).length() > 0.01 * h * h)
-            .collect();
-        assert!(flat.is_empty(), "seed {seed}: {text} at {res}: faces in the apex's grid plane: {flat:?}");
+        check_countersink(seed);
     }
+}
+
+/// From a soak of the test above past its CI seeds: at 32 cells the flips had joined the two
+/// centres beside the plane across the edge they both fanned, leaving two triangles standing flat
+/// in the plane that the weld, looking for the unflipped pair only, did not see.
+#[test]
+fn a_flipped_fin_at_a_countersinks_apex_is_welded_on_seed_18239() {
+    check_countersink(18_239);
+}
+
+/// From the same soak, at 128 cells: the two centres' y coordinates differed by 3e-8 (2e-6 of a
+/// cell, one rounding step), and the weld asked them to agree to 1e-6 of a cell.
+#[test]
+fn centres_a_rounding_step_apart_are_welded_on_seed_18245() {
+    check_countersink(18_245);
+}
+
+/// Open, from the same soak (61 seeds, 18200–18260): fins are left where the two centres beside
+/// the plane lie a tenth of a cell apart (18226, at 64 cells) or do not face each other (18215).
+#[test]
+#[ignore]
+fn countersink_fins_left_on_seeds_18215_18226() {
+    check_countersink(18_215);
+    check_countersink(18_226);
+}
+
+fn check_countersink(seed: u64) {
+    let mut rng = Rng::new(seed);
+    let res = [32, 64, 128][rng.below(3) as usize];
+    let radius = rng.range(0.2, 0.35);
+    let z = (rng.below(5) as f32 - 2.0) / 8.0;
+    let y = rng.range(-0.3, 0.3);
+    let text = format!(
+        "subtract(box(0.6, 0.6, 0.6), translate(rotate(cone({radius}, {radius}), 0, 1, 0, 90), -0.65, {y}, {z}))"
+    );
+    let field = expr::compile(&text).unwrap();
+    let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res).unwrap();
+    let out = emc_on(&field, &grid, &EmcOptions::default());
+    // Faces lying in the plane (all three corners within a twentieth of a cell of it) next to
+    // the apex: the cone crosses the plane at right angles there.
+    let h = grid.cell_size();
+    let apex = Vec3::new(-0.65 + radius, y, z);
+    let flat: Vec<[Vec3; 3]> = out
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| out.mesh.positions[v as usize]))
+        .filter(|c| c.iter().all(|p| (p.z - z).abs() < 0.05 * h && p.distance(apex) < 1.5 * h))
+        .filter(|c| (c[1] - c[0]).cross(c[2] - c[0]).length() > 0.01 * h * h)
+        .collect();
+    assert!(flat.is_empty(), "seed {seed}: {text} at {res}: faces in the apex's grid plane: {flat:?}");
 }
 
 /// Shrunk from `cone_apexes_in_grid_planes_leave_no_fins` (seed 18205, at 32 cells): after the

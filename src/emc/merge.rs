@@ -75,10 +75,15 @@ pub fn merge_flat_crossings(
 /// plane at 32, 48, 64 and 128 cells). One vertex on the face serves both fans, and the two
 /// triangles, then the same triangle twice in opposite orientations, cover nothing.
 ///
+/// The flips run first and may have turned that edge into one joining the two centres, with the
+/// same two triangles standing as flat in the face (a fin); that pair is welded alike (8 of 61
+/// random countersinks had one, `cone_apexes_in_grid_planes_leave_no_fins` past its CI seeds).
+///
 /// Only that configuration is welded: the two centres differ along one axis alone, by at most
 /// two insets and a quarter of the grid's spacing there, with a grid plane between them, where
-/// the vertex goes; under the link condition (they share exactly the edge's two ends as
-/// neighbours and are not joined), so the surface keeps its topology and stays manifold; and
+/// the vertex goes; under the link condition (they share exactly the edge's two ends, or the two
+/// crossings of the flipped pair, as neighbours, and are joined only where flipped), so the
+/// surface keeps its topology and stays manifold; and
 /// where no triangle around the welded vertex would cross another (on noise over cells six times
 /// longer than wide, a weld put a centre on the face between two of MC's polygon centres a
 /// fiftieth of a cell either side of it: eight crossing pairs, `props_grids` seed 3500133).
@@ -91,14 +96,17 @@ pub fn weld_facing_centres(
     grid: (Vec3, Vec3),
 ) -> usize {
     let mut incident = incident_near_centres(mesh, fan_centre);
-    // The edges between crossings, with the triangle on each side: sorted, an edge's two
-    // triangles are neighbours in the list.
+    // The edges between two crossings or between two fan centres, with the triangle on each
+    // side: sorted, an edge's two triangles are neighbours in the list. The pair of centres
+    // either faces each other over an edge between crossings, or was joined by a flip of that
+    // edge (`flip::flip_toward_features` runs first): then the two triangles are the same two
+    // crossings and centres turned the other way, as flat in the face.
     let mut edges: Vec<((u32, u32), u32)> = Vec::new();
     let fanned = |tri: &&[u32; 3]| tri.iter().any(|&v| fan_centre[v as usize]);
     for (t, tri) in mesh.triangles.iter().enumerate().filter(|(_, tri)| fanned(tri)) {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if !fan_centre[a as usize] && !fan_centre[b as usize] {
+            if fan_centre[a as usize] == fan_centre[b as usize] {
                 edges.push(((a.min(b), a.max(b)), t as u32));
             }
         }
@@ -114,16 +122,30 @@ pub fn weld_facing_centres(
         if e != f || dead[t1 as usize] || dead[t2 as usize] {
             continue;
         }
+        let holds_edge = |t: u32| [e.0, e.1].iter().all(|v| mesh.triangles[t as usize].contains(v));
+        if !holds_edge(t1) || !holds_edge(t2) {
+            continue; // an end was welded away since the list was made
+        }
         let apex = |t: u32| mesh.triangles[t as usize].into_iter().find(|&v| v != e.0 && v != e.1);
-        let (Some(c1), Some(c2)) = (apex(t1), apex(t2)) else { continue };
+        let (Some(x1), Some(x2)) = (apex(t1), apex(t2)) else { continue };
+        // The two centres and the two crossings they share, and whether the centres are joined.
+        let (c1, c2, mut shared, joined) =
+            if fan_centre[e.0 as usize] { (e.0, e.1, [x1, x2], true) } else { (x1, x2, [e.0, e.1], false) };
+        shared.sort_unstable();
         let (p1, p2) = (mesh.positions[c1 as usize], mesh.positions[c2 as usize]);
-        if c1 == c2 || !fan_centre[c1 as usize] || !fan_centre[c2 as usize] {
+        if c1 == c2 || shared[0] == shared[1] {
+            continue;
+        }
+        if !fan_centre[c1 as usize]
+            || !fan_centre[c2 as usize]
+            || shared.iter().any(|&v| fan_centre[v as usize])
+        {
             continue;
         }
         let Some(on_face) = across_one_grid_plane(p1, p2, grid) else { continue };
         let (ring1, ring2) = (ring(mesh, &incident[c1 as usize], c1), ring(mesh, &incident[c2 as usize], c2));
         let common: Vec<u32> = ring1.iter().copied().filter(|v| ring2.binary_search(v).is_ok()).collect();
-        if common != [e.0, e.1] || ring1.binary_search(&c2).is_ok() {
+        if common != shared || ring1.binary_search(&c2).is_ok() != joined {
             continue;
         }
         let around: Vec<u32> = incident[c1 as usize]
@@ -185,13 +207,19 @@ fn weld_crosses(
         })
 }
 
+/// How far (in cells) two centres' other coordinates may differ and still count as one point: the
+/// two cells place their centres each from its own arithmetic, and a millionth of a cell (what
+/// this was) is under one rounding step of a coordinate near 0.36 at 128 cells (seed 18245 of
+/// `cone_apexes_in_grid_planes_leave_no_fins`: 3e-8 apart, 2e-6 of a cell).
+const SAME: f32 = 1e-4;
+
 /// Where two centres kept [`INSET`] off either side of one grid plane (the grid's origin and
 /// spacing in `grid`) meet in it: their midpoint, put on the plane; `None` unless they differ along
-/// one axis alone (to a millionth of the spacing), by at most 2.25 insets there, across a plane.
+/// one axis alone (to [`SAME`] of the spacing), by at most 2.25 insets there, across a plane.
 fn across_one_grid_plane(p1: Vec3, p2: Vec3, (origin, spacing): (Vec3, Vec3)) -> Option<Vec3> {
     let d = (p2 - p1).abs();
     let axis = d.max_position();
-    let same = (0..3).all(|a| a == axis || d[a] <= 1e-6 * spacing[a]);
+    let same = (0..3).all(|a| a == axis || d[a] <= SAME * spacing[a]);
     if !same || d[axis] > 2.25 * INSET * spacing[axis] {
         return None;
     }
