@@ -76,8 +76,8 @@ pub fn merge_flat_crossings(
 /// triangles, then the same triangle twice in opposite orientations, cover nothing.
 ///
 /// The flips run first and may have turned that edge into one joining the two centres, with the
-/// same two triangles standing as flat in the face (a fin); that pair is welded alike (8 of 61
-/// random countersinks had one, `cone_apexes_in_grid_planes_leave_no_fins` past its CI seeds).
+/// same two triangles standing as flat in the face (a fin); that pair is welded alike (with the
+/// looser `SAME`, fins on 161 random countersinks went from 31 to 13: docs/emc.md).
 ///
 /// Only that configuration is welded: the two centres differ along one axis alone, by at most
 /// two insets and a quarter of the grid's spacing there, with a grid plane between them, where
