@@ -122,14 +122,22 @@ impl Field for Clipped<'_> {
             return None;
         }
         let (flo, fhi) = (self.scaled(flo), self.scaled(fhi));
-        let corners = (0..8).map(|c| {
-            Vec3::new(
-                if c & 1 == 0 { lo.x } else { hi.x },
-                if c & 2 == 0 { lo.y } else { hi.y },
-                if c & 4 == 0 { lo.z } else { hi.z },
-            )
-        });
-        let box_hi = corners.map(|p| self.box_distance(p).0).fold(f32::NEG_INFINITY, f32::max);
+        let box_hi = if lo.cmpge(self.min).all() && hi.cmple(self.max).all() {
+            // Every corner inside the box, where its distance is the largest of the per-axis
+            // ones: the same maximum, axis by axis (the crust asks this of every node).
+            let (centre, half) = ((self.min + self.max) * 0.5, (self.max - self.min) * 0.5);
+            let q = |p: Vec3| (p - centre).abs() - half;
+            q(lo).max(q(hi)).max_element()
+        } else {
+            let corners = (0..8).map(|c| {
+                Vec3::new(
+                    if c & 1 == 0 { lo.x } else { hi.x },
+                    if c & 2 == 0 { lo.y } else { hi.y },
+                    if c & 4 == 0 { lo.z } else { hi.z },
+                )
+            });
+            corners.map(|p| self.box_distance(p).0).fold(f32::NEG_INFINITY, f32::max)
+        };
         let gap = (lo - self.max).max(self.min - hi).max_element();
         let low = if gap > 0.0 { flo.max(gap) } else { flo };
         Some((low, fhi.max(box_hi)))
@@ -150,8 +158,16 @@ impl Field for Clipped<'_> {
     fn values_and_gradients(&self, points: &[Vec3], values: &mut [f32], gradients: &mut [Option<Vec3>]) {
         self.field.values_and_gradients(points, values, gradients);
         for ((v, g), &p) in values.iter_mut().zip(gradients.iter_mut()).zip(points) {
-            *g = self.combine_gradient(*v, *g, p);
-            *v = self.combine(*v, p);
+            if v.is_finite() || self.clamp(p) == p {
+                // `combine` and `combine_gradient` in one, the box's distance found once.
+                let (d, box_gradient) = self.box_distance(p);
+                let scaled = self.scaled(*v);
+                *g = if d > scaled { Some(box_gradient) } else { g.map(|g| g / self.slope) };
+                *v = scaled.max(d);
+            } else {
+                *g = self.combine_gradient(*v, *g, p);
+                *v = self.combine(*v, p);
+            }
         }
     }
 }

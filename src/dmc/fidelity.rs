@@ -55,7 +55,8 @@ impl<'a> Fidelity<'a> {
         self.find_crossings(tree, &all);
         // Per triangle its centroid and its edges' midpoints, each midpoint evaluated once.
         self.points.clear();
-        let mut midpoints: HashMap<(DualEdge, DualEdge), u32> = HashMap::default();
+        let mut midpoints: HashMap<(DualEdge, DualEdge), u32> =
+            HashMap::with_capacity_and_hasher(2 * all.len(), Default::default());
         let mut samples: Vec<[u32; 4]> = Vec::with_capacity(all.len());
         for t in &all {
             let corners = t.map(|e| self.crossings[&e]);
@@ -100,7 +101,9 @@ impl<'a> Fidelity<'a> {
     fn find_crossings(&mut self, tree: &Octree, tris: &[EdgeTriangle]) {
         let mut edges: Vec<(VertexKey, VertexKey)> =
             tris.iter().flatten().copied().filter(|e| !self.crossings.contains_key(e)).collect();
-        edges.sort_unstable();
+        // Sorted by one packed integer, in the order of the keys (node, then clamp).
+        let packed = |k: VertexKey| (k.node as u128) << 8 | k.clamp as u128;
+        edges.sort_unstable_by_key(|&(a, b)| packed(a) << 64 | packed(b));
         edges.dedup();
         let segments: Vec<Segment> = edges
             .iter()
