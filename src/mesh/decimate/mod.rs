@@ -134,6 +134,19 @@ pub fn decimate(
     state.collapse_slivers();
     state.relax_slivers();
     state.improve_angles();
+    // The slivers left have their corners on feature lines: Steiner points, where the target
+    // leaves room for their triangles (any room, where the checks stopped the collapses short of
+    // it), then the same passes again.
+    let room =
+        if state.alive_count > options.target_triangles { usize::MAX } else { options.target_triangles };
+    for _ in 0..SPLIT_ROUNDS {
+        if state.split_slivers(room) == 0 {
+            break;
+        }
+        state.collapse_slivers();
+        state.relax_slivers();
+        state.improve_angles();
+    }
     Ok(state.finish(mesh))
 }
 
@@ -143,6 +156,11 @@ pub fn decimate(
 const MAX_ROUNDS: usize = 3;
 /// Another round follows only while the last one removed more than one in this many triangles.
 const ROUND_GAIN: usize = 100;
+
+/// Rounds of Steiner points for the slivers the other passes leave, at most: on EMC's gear at 64
+/// cells decimated towards a tenth, one round takes the share under 10° from 3.4 % to 0.7 % with
+/// 92 triangles more, a second to 0.4 % with 10 more, a third changes nothing.
+const SPLIT_ROUNDS: usize = 2;
 
 /// Heap entries looked at between two checkpoints.
 const POPS_PER_CHECKPOINT: usize = 4096;

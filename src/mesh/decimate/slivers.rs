@@ -102,6 +102,88 @@ impl State<'_> {
         })
     }
 
+    /// Splits, at its midpoint, the longest edge of each sliver that is not a feature edge: a
+    /// free vertex where there was none. Slivers whose corners all lie on feature lines (a flat
+    /// face between a curved crease, densely sampled, and a straight one, thinned out to its
+    /// ends) can be mended neither by a collapse nor by moving a corner, and a flip of such a
+    /// face only trades one thin triangle for another: the face needs a vertex of its own, a
+    /// Steiner point, which the passes after this one move, collapse and flip into place. The
+    /// split moves nothing (the new vertex lies on the edge, its four faces on the old two), so
+    /// it needs no check but the error bound's, whose samples move. No split takes the count of
+    /// faces over `room`. How many edges were split.
+    pub(super) fn split_slivers(&mut self, room: usize) -> usize {
+        let sliver = SLIVER_DEG.to_radians();
+        let mut count = 0;
+        for f in 0..self.tris.len() as u32 {
+            if self.alive_count + 2 > room {
+                break;
+            }
+            if !self.alive[f as usize] || min_angle(&self.corners(f)) >= sliver {
+                continue;
+            }
+            let t = self.tris[f as usize];
+            let length = |i: usize| (self.pos[t[i] as usize] - self.pos[t[(i + 1) % 3] as usize]).length();
+            let longest = (0..3)
+                .filter(|&i| !self.lines.contains_key(&key(t[i], t[(i + 1) % 3])))
+                .max_by(|&i, &j| length(i).total_cmp(&length(j)));
+            if let Some(i) = longest {
+                count += self.split_edge(f, t[i], t[(i + 1) % 3]) as usize;
+            }
+        }
+        count
+    }
+
+    /// Splits the edge `a → b` of face `f1 = (a, b, c)` and its neighbour `f2 = (b, a, d)` at
+    /// the edge's midpoint `m`: `(a, m, c)`, `(m, b, c)`, `(b, m, d)`, `(m, a, d)`, wound as
+    /// before. Whether the edge had that neighbour and kept to the error bound (and was split).
+    pub(super) fn split_edge(&mut self, f1: u32, a: u32, b: u32) -> bool {
+        let Some(&f2) =
+            self.faces_of[a as usize].iter().find(|&&g| g != f1 && self.tris[g as usize].contains(&b))
+        else {
+            return false;
+        };
+        let (t1, t2) = (self.tris[f1 as usize], self.tris[f2 as usize]);
+        let m = self.pos.len() as u32;
+        let midpoint = 0.5 * (self.pos[a as usize] + self.pos[b as usize]);
+        // The surface stays, but the points where its distance is measured move: none of them
+        // may leave the bound (or, where the old faces were already outside it, get farther).
+        let corners =
+            |t: [u32; 3], from: u32| t.map(|v| if v == from { midpoint } else { self.pos[v as usize] });
+        let new = [corners(t1, b), corners(t1, a), corners(t2, a), corners(t2, b)];
+        let old = [self.corners(f1), self.corners(f2)];
+        if !self.within_error(midpoint, &new) && self.face_distance(&new) > self.face_distance(&old) {
+            return false;
+        }
+        self.pos.push(midpoint);
+        self.kind.push(Kind::Free);
+        self.moved.push(true);
+        self.quadric.push(Default::default());
+        self.area.push(0.0);
+        self.stamp.push(0);
+        self.line_neighbours.push(Vec::new());
+        let replace = |t: [u32; 3], from: u32| t.map(|v| if v == from { m } else { v });
+        let (f3, f4) = (self.tris.len() as u32, self.tris.len() as u32 + 1);
+        self.tris[f1 as usize] = replace(t1, b);
+        self.tris[f2 as usize] = replace(t2, a);
+        self.tris.push(replace(t1, a));
+        self.tris.push(replace(t2, b));
+        self.alive.extend([true, true]);
+        self.alive_count += 2;
+        let third = |t: [u32; 3]| t.into_iter().find(|&v| v != a && v != b).unwrap_or(a);
+        let (c, d) = (third(t1), third(t2));
+        self.faces_of[a as usize].retain(|&g| g != f2);
+        self.faces_of[a as usize].push(f4);
+        self.faces_of[b as usize].retain(|&g| g != f1);
+        self.faces_of[b as usize].push(f3);
+        self.faces_of[c as usize].push(f3);
+        self.faces_of[d as usize].push(f4);
+        self.faces_of.push(vec![f1, f2, f3, f4]);
+        for f in [f1, f2, f3, f4] {
+            self.insert_face(f);
+        }
+        true
+    }
+
     /// Flips the non-feature edges of slivers where that raises the pair's smallest angle.
     pub(super) fn improve_angles(&mut self) {
         self.sweep_slivers(|state, f, _| {

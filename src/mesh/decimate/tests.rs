@@ -104,3 +104,34 @@ fn the_balanced_vertex_of_a_fan_on_a_ball_sits_outside_and_cuts_the_error_by_a_q
         }
     }
 }
+
+/// A split moves nothing: the mesh stays closed with its Euler characteristic, area and volume,
+/// two triangles more, the new vertex at the edge's midpoint and free.
+#[test]
+fn splitting_an_edge_keeps_the_surface_and_its_topology() {
+    let out = emc("subtract(box(0.6, 0.6, 0.6), sphere(0.75))", 16);
+    let before = topology(&out.mesh);
+    let mut state = State::new(&out.mesh, &out.feature_edges, None, &DecimateOptions::default());
+    let count = state.alive_count;
+    let mut split = 0;
+    for f in (0..state.tris.len() as u32).step_by(7) {
+        let t = state.tris[f as usize];
+        if state.alive[f as usize] && !state.lines.contains_key(&key(t[0], t[1])) {
+            let midpoint = 0.5 * (state.pos[t[0] as usize] + state.pos[t[1] as usize]);
+            assert!(state.split_edge(f, t[0], t[1]));
+            assert_eq!(*state.pos.last().unwrap(), midpoint);
+            assert_eq!(*state.kind.last().unwrap(), Kind::Free);
+            split += 1;
+        }
+    }
+    assert!(split > 20, "{split} edges split");
+    assert_eq!(state.alive_count, count + 2 * split);
+    let d = state.finish(&out.mesh);
+    let after = topology(&d.mesh);
+    assert!(after.is_closed_manifold() && after.euler == before.euler, "{after:?}");
+    assert_eq!(d.mesh.triangle_count(), out.mesh.triangle_count() + 2 * split);
+    use crate::mesh::analysis::quality::{signed_volume as volume, surface_area as area};
+    assert!((area(&d.mesh) - area(&out.mesh)).abs() < 1e-6 * area(&out.mesh));
+    assert!((volume(&d.mesh) - volume(&out.mesh)).abs() < 1e-6 * volume(&out.mesh).abs());
+    assert_eq!(self_intersections(&d.mesh), 0);
+}
