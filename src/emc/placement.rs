@@ -35,6 +35,9 @@ pub(crate) const INSET: f32 = 1e-2;
 const LINE_SAMPLES: usize = 32;
 /// How far (in cells) a fan centre may leave its cell, where the planes meet just outside it.
 pub const GROWTH: f32 = 0.5;
+/// How far (in cells) a centre on its feature, and on the surface, may leave its cell where none
+/// nearer is (see [`place_far`]).
+pub const FAR_GROWTH: f32 = 2.0;
 /// Lattice points per axis when searching the cell for a valid fan near the feature.
 const LATTICE_SAMPLES: usize = 8;
 /// Steps from the polygon's centroid toward the target in the last resort.
@@ -90,7 +93,20 @@ impl Placement {
 /// its fan turns out to cut a neighbour's triangles (see [`super::untangle`]); a component that
 /// has no valid centre inside its cell is not given one outside either.
 pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
-    let at = place_within(solved, kind, component, GROWTH)?;
+    place_grown(solved, kind, component, GROWTH)
+}
+
+/// A centre on the solved feature up to [`FAR_GROWTH`] cells from the component's cell, for a
+/// component [`place`] gave no point on it: where a thin wedge of the part (a ball meeting a face
+/// at a shallow angle) lies between grid points, the cells along its crease see no surface, and
+/// their neighbours see the two sheets but not the crease, which is a cell or more away. A point
+/// there is on two planes; the caller keeps it only where it is also on the surface.
+pub fn place_far(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
+    place_grown(solved, kind, component, FAR_GROWTH).filter(|placed| placed.at.on_feature)
+}
+
+fn place_grown(solved: Vec3, kind: FeatureKind, component: &Component, growth: f32) -> Option<Placed> {
+    let at = place_within(solved, kind, component, growth)?;
     let p = at.position;
     // Strictly inside: a centre in a face of the cell would lay fan triangles in that face, over
     // the neighbour's (a centre inside is the apex of a cone that meets the boundary only in its

@@ -80,16 +80,27 @@ fn place_on_crease(
 }
 
 /// `point` placed in the component's cell ([`placement::place`]), and where `surface` is given,
-/// checked to lie within its distance of the sampler's surface ([`Placed::check_surface`]).
+/// checked to lie within its distance of the sampler's surface ([`Placed::check_surface`]);
+/// where that gives no feature vertex, [`placement::place_far`]'s point if it is one.
 fn place(
     point: Vec3,
     kind: FeatureKind,
     component: &Component,
     surface: Option<(&dyn EdgeSampler, f32)>,
 ) -> Option<(Placed, FeatureKind)> {
-    let mut placed = placement::place(point, kind, component)?;
-    if let Some((sampler, on_surface)) = surface {
+    let placed = placement::place(point, kind, component);
+    let Some((sampler, on_surface)) = surface else { return placed.map(|p| (p, kind)) };
+    let checked = |mut placed: Placed| {
         placed.check_surface(|p| sampler.distance(p), on_surface);
+        placed
+    };
+    let placed = placed.map(checked);
+    if placed.is_some_and(|p| p.at.is_feature_vertex()) {
+        return placed.map(|p| (p, kind));
     }
-    Some((placed, kind))
+    // No centre on the feature near the cell: farther, where the input says it is on the surface
+    // (not merely that it cannot tell: a flat field, as on samples at the level, says nothing).
+    let on_it = |p: &Placed| sampler.distance(p.at.position).is_some_and(|d| d <= on_surface);
+    let far = placement::place_far(point, kind, component).map(checked);
+    far.filter(|p| p.at.is_feature_vertex() && on_it(p)).or(placed).map(|p| (p, kind))
 }
