@@ -137,12 +137,22 @@ impl State<'_> {
     /// the edge's midpoint `m`: `(a, m, c)`, `(m, b, c)`, `(b, m, d)`, `(m, a, d)`, wound as
     /// before. Whether the edge had that neighbour and kept to the error bound (and was split).
     pub(super) fn split_edge(&mut self, f1: u32, a: u32, b: u32) -> bool {
-        let Some(&f2) =
-            self.faces_of[a as usize].iter().find(|&&g| g != f1 && self.tris[g as usize].contains(&b))
-        else {
-            return false;
+        // Exactly one other face on the edge, wound the other way along it: not an open or a
+        // non-manifold edge, where four new faces would not cover what was there.
+        let on_edge: Vec<u32> = self.faces_of[a as usize]
+            .iter()
+            .copied()
+            .filter(|&g| self.tris[g as usize].contains(&b))
+            .collect();
+        let (t1, f2) = match on_edge[..] {
+            [x, y] if x == f1 || y == f1 => (self.tris[f1 as usize], if x == f1 { y } else { x }),
+            _ => return false,
         };
-        let (t1, t2) = (self.tris[f1 as usize], self.tris[f2 as usize]);
+        let t2 = self.tris[f2 as usize];
+        let runs = |t: [u32; 3], from: u32, to: u32| (0..3).any(|i| t[i] == from && t[(i + 1) % 3] == to);
+        if !runs(t1, a, b) || !runs(t2, b, a) {
+            return false;
+        }
         let m = self.pos.len() as u32;
         let midpoint = 0.5 * (self.pos[a as usize] + self.pos[b as usize]);
         // The surface stays, but the points where its distance is measured move: none of them
