@@ -383,7 +383,7 @@ fn union_of_boxes_on_grid_planes_has_no_teeth() {
 /// cell or more away. Random boxes and balls meeting their faces at 34° or more, some with faces
 /// on grid planes, at random resolutions: under 1 % of the faces more than 30° off the surface.
 /// Measured over 100 seeds: at most 0.4 % (a few centres a cell or two along the circle still
-/// approximate, 0–19 per part), where before `placement::place_far` most parts had 150–560
+/// approximate, up to 34 per part), where before `placement::place_far` most parts had 150–560
 /// approximate centres and a normal p95 of 22–47°. Not asserted: no more faces off than MC's
 /// polygons, which seed 18465 (faces on grid planes, 60 cells) breaks with 57 against none,
 /// before and after the far placement alike (found by this soak, open).

@@ -102,6 +102,17 @@ pub fn place(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<P
 /// their neighbours see the two sheets but not the crease, which is a cell or more away. A point
 /// there is on two planes; the caller keeps it only where it is also on the surface.
 pub fn place_far(solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
+    // The solved point itself first, where its fan is valid: the line's samples step over it.
+    if in_box(solved, component.grown(FAR_GROWTH)) && fan_is_valid(solved, component.pts, component.nrm) {
+        let at = Placement { position: solved, on_feature: true, off_surface: false };
+        let inside = component.cell_min.cmplt(solved).all() && solved.cmplt(component.cell_max).all();
+        if inside {
+            return Some(Placed { at, inside: None });
+        }
+        if let Some(inside) = place_within(solved, kind, component, -INSET) {
+            return Some(Placed { at, inside: Some(inside) });
+        }
+    }
     place_grown(solved, kind, component, FAR_GROWTH).filter(|placed| placed.at.on_feature)
 }
 
