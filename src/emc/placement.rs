@@ -105,19 +105,20 @@ pub fn place_far(solved: Vec3, kind: FeatureKind, component: &Component) -> Opti
     // The solved point itself first, where its fan is valid: the line's samples step over it.
     if in_box(solved, component.grown(FAR_GROWTH)) && fan_is_valid(solved, component.pts, component.nrm) {
         let at = Placement { position: solved, on_feature: true, off_surface: false };
-        let inside = component.cell_min.cmplt(solved).all() && solved.cmplt(component.cell_max).all();
-        if inside {
-            return Some(Placed { at, inside: None });
-        }
-        if let Some(inside) = place_within(solved, kind, component, -INSET) {
-            return Some(Placed { at, inside: Some(inside) });
+        if let Some(placed) = with_inside(at, solved, kind, component) {
+            return Some(placed);
         }
     }
     place_grown(solved, kind, component, FAR_GROWTH).filter(|placed| placed.at.on_feature)
 }
 
 fn place_grown(solved: Vec3, kind: FeatureKind, component: &Component, growth: f32) -> Option<Placed> {
-    let at = place_within(solved, kind, component, growth)?;
+    with_inside(place_within(solved, kind, component, growth)?, solved, kind, component)
+}
+
+/// `at`, with the best centre inside the cell where `at` is not strictly inside it; `None` where
+/// it is not and the cell has no valid centre.
+fn with_inside(at: Placement, solved: Vec3, kind: FeatureKind, component: &Component) -> Option<Placed> {
     let p = at.position;
     // Strictly inside: a centre in a face of the cell would lay fan triangles in that face, over
     // the neighbour's (a centre inside is the apex of a cone that meets the boundary only in its

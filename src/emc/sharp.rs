@@ -100,7 +100,8 @@ fn place(
     }
     // No centre on the feature near the cell: farther, where the input says it is on the surface
     // (not merely that it cannot tell: a flat field, as on samples at the level, says nothing).
+    // (`place_far` gives only points on the feature, and one on the surface is not off it.)
     let on_it = |p: &Placed| sampler.distance(p.at.position).is_some_and(|d| d <= on_surface);
-    let far = placement::place_far(point, kind, component).map(checked);
-    far.filter(|p| p.at.is_feature_vertex() && on_it(p)).or(placed).map(|p| (p, kind))
+    let far = placement::place_far(point, kind, component).filter(on_it).map(checked);
+    far.or(placed).map(|p| (p, kind))
 }
