@@ -151,17 +151,25 @@ fn the_sampled_hausdorff_distance_is_exact_where_it_can_be_checked() {
 }
 
 /// The fandisk (12 946 triangles, one closed genus-0 part with flat, cylindrical and rounded
-/// faces) at 64 cells.
+/// faces) at 64 and 72 cells. Its largest error is where a face half a cell wide runs between
+/// two creases and tapers out; two fan centres there (`emc::strip`) took 72 cells from 0.425 %
+/// to 0.252 % (64: 0.345 % to 0.337 %).
 #[test]
 fn the_fandisk_remeshes_closed_genus_0_within_the_bound() {
     let input = model("fandisk");
-    let mc = remesh(&input, Method::Mc, 64);
-    let emc = remesh(&input, Method::Emc, 64);
-    report("fandisk", 64, &mc, &emc);
-    assert_eq!(emc.euler, 2, "genus 0");
-    assert_eq!(mc.euler, 2);
-    assert!(emc.relative <= 0.0036, "EMC Hausdorff {:.3} % of the diagonal", 100.0 * emc.relative);
-    assert!(emc.relative * 2.5 < mc.relative, "EMC {} against MC {}", emc.relative, mc.relative);
+    for (res, bound) in [(64, 0.0036), (72, 0.0030)] {
+        let mc = remesh(&input, Method::Mc, res);
+        let emc = remesh(&input, Method::Emc, res);
+        report("fandisk", res, &mc, &emc);
+        assert_eq!(emc.euler, 2, "genus 0");
+        assert_eq!(mc.euler, 2);
+        assert!(
+            emc.relative <= bound,
+            "EMC Hausdorff {:.3} % of the diagonal at {res}",
+            100.0 * emc.relative
+        );
+        assert!(emc.relative * 2.5 < mc.relative, "EMC {} against MC {} at {res}", emc.relative, mc.relative);
+    }
 }
 
 /// Three smaller CAD parts of higher genus: closed, with their genus, nearer than MC.

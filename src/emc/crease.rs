@@ -37,6 +37,20 @@ const MIN_MEAN: f32 = 0.2;
 /// a jump, or where the sampler cannot walk the surface (stored and sampled inputs: the paper's
 /// test stands there).
 pub fn smooth_at_fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSampler, theta_sharp: f32) -> bool {
+    fine_scale(pts, nrm, sampler, theta_sharp).smooth
+}
+
+/// What [`smooth_at_fine_scale`] saw: whether the surface is smooth, and a point of the surface
+/// (with its normal) that a walk met between two crossings and that turns past θ against both:
+/// a face between two creases too narrow for the cell's crossings to land on (see
+/// [`super::strip`]).
+pub struct FineScale {
+    pub smooth: bool,
+    pub between: Option<(Vec3, Vec3)>,
+}
+
+/// [`smooth_at_fine_scale`], with the face between the walked crossings where one was met.
+pub fn fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSampler, theta_sharp: f32) -> FineScale {
     let mut pairs: Vec<(f32, usize, usize)> = Vec::new();
     for i in 0..nrm.len() {
         for j in i + 1..nrm.len() {
@@ -47,12 +61,16 @@ pub fn smooth_at_fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSample
         }
     }
     if pairs.is_empty() {
-        return false;
+        return FineScale { smooth: false, between: None };
     }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    pairs.iter().take(PAIRS).all(|&(_, i, j)| {
-        path_is_smooth((pts[i], nrm[i]), (pts[j], nrm[j]), sampler, theta_sharp) == Some(true)
-    })
+    let mut between = None;
+    let smooth = pairs.iter().take(PAIRS).all(|&(_, i, j)| {
+        let walked = walk((pts[i], nrm[i]), (pts[j], nrm[j]), sampler, theta_sharp, true);
+        between = between.or(walked.as_ref().and_then(|w| w.between));
+        walked.map(|w| w.smooth) == Some(true)
+    });
+    FineScale { smooth, between }
 }
 
 /// A sharp component that looks like three sheets but has two at the fine scale: its third
@@ -110,10 +128,12 @@ pub struct Crease {
     pub sides: [(Vec3, Vec3); 2],
 }
 
-/// What [`walk`] found: whether the path is smooth, and where it ended.
+/// What [`walk`] found: whether the path is smooth, where it ended, and the first point it
+/// sampled whose normal turns past θ against both ends'.
 struct Walk {
     smooth: bool,
     crease: Crease,
+    between: Option<(Vec3, Vec3)>,
 }
 
 /// Bisects the path between crossings `a` and `b`, keeping the half whose ends' normals differ
@@ -146,6 +166,7 @@ fn walk(
     let (mut s0, mut p0, mut n0, mut s1, mut p1, mut n1) = (0.0f32, a.0, a.1, 1.0f32, b.0, b.1);
     let first_jump = n0.angle_between(n1);
     let mut settled = false;
+    let mut between = None;
     for halving in 0..HALVINGS {
         if settle_early && halving == SETTLED_AFTER && n0.angle_between(n1) >= KEPT * first_jump {
             settled = true;
@@ -156,6 +177,9 @@ fn walk(
         if n == Vec3::ZERO {
             return None;
         }
+        if between.is_none() && a.1.dot(n) < theta_sharp && b.1.dot(n) < theta_sharp {
+            between = Some((p, n));
+        }
         if n0.dot(n) < n.dot(n1) {
             (s1, p1, n1) = (s, p, n);
         } else {
@@ -163,7 +187,7 @@ fn walk(
         }
     }
     let crease = Crease { at: (p0 + p1) * 0.5, sides: [(p0, n0), (p1, n1)] };
-    Some(Walk { smooth: !settled && n0.dot(n1) >= theta_sharp, crease })
+    Some(Walk { smooth: !settled && n0.dot(n1) >= theta_sharp, crease, between })
 }
 
 #[cfg(test)]

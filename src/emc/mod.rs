@@ -26,6 +26,7 @@ mod plan;
 pub mod point_source;
 pub mod resample;
 mod sharp;
+pub mod strip;
 pub mod untangle;
 pub mod winding;
 
@@ -399,17 +400,37 @@ fn extract_slab(
                 let pts: Vec<Vec3> = ids.iter().map(|&v| out.mesh.positions[v as usize]).collect();
                 let nrm: Vec<Vec3> = ids.iter().map(|&v| normals_of_vertex[v as usize]).collect();
                 let kind = classify(&nrm, options.theta_sharp, options.phi_corner);
-                let mut feature = None;
+                let (mut feature, mut strip, mut sharp_kind) = (None, None, FeatureKind::Smooth);
                 if kind != FeatureKind::Smooth {
                     let domain = (grid.origin, grid.max());
                     let component = Component { pts: &pts, nrm: &nrm, cell_min, cell_max, domain };
-                    let sharp =
-                        sharp::solve(kind, &component, sampler, options, ON_SURFACE * grid.cell_size());
-                    out.rejected_features +=
-                        (sharp.kind != FeatureKind::Smooth && sharp.feature.is_none()) as usize;
-                    feature = sharp.feature;
+                    let on_surface = ON_SURFACE * grid.cell_size();
+                    let sharp = sharp::solve(kind, &component, sampler, options, on_surface);
+                    (feature, sharp_kind) = (sharp.feature, sharp.kind);
+                    // No feature vertex: two creases may bound a face narrower than the cell.
+                    let met = feature.as_ref().is_some_and(|(placed, _)| placed.at.is_feature_vertex());
+                    if sharp_kind != FeatureKind::Smooth && !met && options.resample_creases {
+                        let distance = |p: Vec3| sampler.distance(p);
+                        strip = strip::solve(&component, options.theta_sharp, &distance, on_surface);
+                    }
+                    // A feature met, but a face between two creases hidden from the crossings.
+                    if let (true, Some(between)) = (met, sharp.between) {
+                        strip = strip::hidden(&component, between, sampler, options.theta_sharp, on_surface);
+                    }
                 }
-                let mut plan = Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature };
+                let mut plan = Plan { by_edge, ids, pts, nrm, cell_edges: poly, group, feature, strip };
+                if plan.strip.is_some() {
+                    let rules = options.better_triangles.as_ref();
+                    let positions = &out.mesh.positions;
+                    if plan.strip_is_nearer(positions, triangles, rules, |p| sampler.distance(p)) {
+                        plan.feature = None;
+                    } else {
+                        plan.strip = None;
+                    }
+                }
+                out.rejected_features += (sharp_kind != FeatureKind::Smooth
+                    && plan.feature.is_none()
+                    && plan.strip.is_none()) as usize;
                 // An approximate centre only bends the patch towards a feature it cannot
                 // reach; where it ends up farther from the surface than MC's own triangles
                 // of the polygon, MC's are kept.
@@ -451,6 +472,7 @@ fn extract_slab(
                         .any(|b| fan.iter().any(|t| current[b].iter().any(|u| triangles_intersect(t, u))));
                     if cuts {
                         plans[a].feature = None;
+                        plans[a].strip = None;
                         out.rejected_features += 1;
                     } else {
                         current[a] = fan;
@@ -459,6 +481,20 @@ fn extract_slab(
             }
             // Pass 3: emit.
             for plan in plans {
+                if let Some((strip, _)) = &plan.strip {
+                    let first = out.mesh.positions.len();
+                    for (centre, crease) in strip.centres.iter().zip(&strip.creases) {
+                        out.mesh.positions.push(*centre);
+                        normals_of_vertex.push(plan.nrm.iter().sum::<Vec3>().normalize_or_zero());
+                        out.feature_vertex.push(true);
+                        centres.push(true, true, *crease);
+                        out.edge_features += 1;
+                    }
+                    let n = plan.ids.len();
+                    let id = |v: usize| if v < n { plan.ids[v] } else { (first + v - n) as u32 };
+                    out.mesh.triangles.extend(strip.triangles.iter().map(|t| t.map(id)));
+                    continue;
+                }
                 let Some((Placed { at: f, inside }, kind)) = plan.feature else {
                     let (tris, extra) =
                         plan.plain(&out.mesh.positions, triangles, options.better_triangles.as_ref());

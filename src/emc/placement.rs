@@ -215,7 +215,7 @@ fn nearest_valid_in_box(
 }
 
 /// The parameter interval `[s0, s1]` of the line `p + s dir` inside `[lo, hi]`, if it meets it.
-fn line_in_box(p: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
+pub(crate) fn line_in_box(p: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
     let (mut s0, mut s1) = (f32::NEG_INFINITY, f32::INFINITY);
     for a in 0..3 {
         if dir[a] == 0.0 {

@@ -4,6 +4,7 @@
 
 use super::feature::FeatureKind;
 use super::placement;
+use super::strip::Strip;
 use crate::mc::{polygon_center, untangled};
 use crate::mcq::polygon::triangulate_cell_polygon;
 use crate::mcq::PolygonRules;
@@ -24,6 +25,10 @@ pub(super) struct Plan<'a> {
     /// Where the fan centre goes, what the feature is, and, for a centre outside the cell, where
     /// it would go inside (see [`super::untangle`]).
     pub feature: Option<(placement::Placed, FeatureKind)>,
+    /// Two centres instead of one, where two creases bound a face narrower than the cell (see
+    /// [`super::strip`]), with the triangles' largest distance from the surface; `feature` is
+    /// then `None`.
+    pub strip: Option<(Strip, f32)>,
 }
 
 /// Stands for the one vertex a component without feature point may add (MC's centre vertex, or
@@ -31,12 +36,38 @@ pub(super) struct Plan<'a> {
 pub(super) const EXTRA: u32 = u32::MAX;
 
 impl Plan<'_> {
-    /// The triangles of this component's fan, as positions, if it has a feature point.
+    /// The triangles of this component's fan, as positions, if it has a feature point or a strip.
     pub fn fan_triangles(&self) -> Option<Vec<[DVec3; 3]>> {
         let n = self.pts.len();
+        if let Some((strip, _)) = &self.strip {
+            let at = |v: usize| if v < n { self.pts[v] } else { strip.centres[v - n] }.as_dvec3();
+            return Some(strip.triangles.iter().map(|t| t.map(at)).collect());
+        }
         let (f, _) = self.feature?;
         let corner = |q: usize| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3());
         Some((0..n).map(corner).collect())
+    }
+
+    /// Whether this component's strip (see [`super::strip`]) lies nearer the surface, at its
+    /// triangles' centroids by `distance`, than what it would be without: the fan around its
+    /// feature point, or MC's triangles (a strip is taken only where the input can tell).
+    pub fn strip_is_nearer(
+        &self,
+        positions: &[Vec3],
+        table: &CellTriangles,
+        rules: Option<&PolygonRules>,
+        distance: impl Fn(Vec3) -> Option<f32>,
+    ) -> bool {
+        let Some((_, strip_worst)) = &self.strip else { return false };
+        let n = self.pts.len();
+        let without = match &self.feature {
+            Some((placed, _)) => {
+                let f = placed.at.position;
+                (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
+            }
+            None => self.plain_triangles(positions, table, rules),
+        };
+        *strip_worst < farthest_centroid(&without, distance)
     }
 
     /// Whether this component's fan centre is an approximate one (off its feature: see
@@ -60,11 +91,7 @@ impl Plan<'_> {
             return false;
         }
         let Some(centre) = distance(placed.at.position) else { return false };
-        let mc_worst = self
-            .plain_triangles(positions, table, rules)
-            .iter()
-            .filter_map(|t| distance(((t[0] + t[1] + t[2]) / 3.0).as_vec3()))
-            .fold(0.0f32, f32::max);
+        let mc_worst = farthest_centroid(&self.plain_triangles(positions, table, rules), distance);
         centre > mc_worst + slack
     }
 
@@ -102,4 +129,9 @@ impl Plan<'_> {
         let id = |e: u8| if e == CENTER { EXTRA } else { self.by_edge[e as usize] };
         (group.chunks_exact(3).map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect(), extra)
     }
+}
+
+/// The largest of `distance` over the triangles' centroids (0 where it cannot tell).
+fn farthest_centroid(triangles: &[[DVec3; 3]], distance: impl Fn(Vec3) -> Option<f32>) -> f32 {
+    triangles.iter().filter_map(|t| distance(((t[0] + t[1] + t[2]) / 3.0).as_vec3())).fold(0.0f32, f32::max)
 }

@@ -21,6 +21,9 @@ use glam::Vec3;
 pub struct Sharp {
     pub kind: FeatureKind,
     pub feature: Option<(Placed, FeatureKind)>,
+    /// A point of the surface, with its normal, between two of the component's crossings that
+    /// turns sharply against both: a face too narrow for a crossing (see [`super::strip`]).
+    pub between: Option<(Vec3, Vec3)>,
 }
 
 /// The feature point of `component`, classified `kind` by §4.2's normal test. `on_surface` is how
@@ -37,17 +40,22 @@ pub fn solve(
     let walk = options.resample_creases;
     // Where the input can be walked (a function, a closed mesh), a crease is kept only where the
     // surface still turns past θ next to it (see `crease`).
-    if kind != FeatureKind::Smooth && walk && crease::smooth_at_fine_scale(pts, nrm, sampler, theta) {
-        kind = FeatureKind::Smooth;
+    let mut between = None;
+    if kind != FeatureKind::Smooth && walk {
+        let fine = crease::fine_scale(pts, nrm, sampler, theta);
+        between = fine.between;
+        if fine.smooth {
+            kind = FeatureKind::Smooth;
+        }
     }
     if kind == FeatureKind::Smooth {
-        return Sharp { kind, feature: None };
+        return Sharp { kind, feature: None, between: None };
     }
     // A third sheet that continues another one smoothly makes an edge, solved from a point on its
     // crease rather than from the tangent planes.
     if let Some(crease) = walk.then(|| crease::two_sheet_crease(pts, nrm, sampler, theta)).flatten() {
         let feature = place_on_crease(&crease, component, sampler, on_surface);
-        return Sharp { kind: FeatureKind::Edge, feature };
+        return Sharp { kind: FeatureKind::Edge, feature, between };
     }
     let near = component.grown(placement::GROWTH);
     let (mut solved_kind, mut solved) = feature::sharp_point(pts, nrm, kind, near);
@@ -57,7 +65,7 @@ pub fn solve(
         }
     }
     let surface = walk.then_some((sampler, on_surface));
-    Sharp { kind, feature: place(solved, solved_kind, component, surface) }
+    Sharp { kind, feature: place(solved, solved_kind, component, surface), between }
 }
 
 /// An edge point on `crease`, resampled from its two sides, placed in the component's cell.
