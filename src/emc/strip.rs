@@ -12,7 +12,9 @@
 //! the polygon is fanned from both: a side's crossings to its crease's centre, the middle face's
 //! to the centre of the side they follow, and one triangle at each end of the middle face's runs
 //! joins the two centres, so the edge between them is shared by exactly two triangles. The
-//! polygon is MC's, as for every fan, so the mesh stays closed whatever is decided inside.
+//! polygon is MC's, as for every fan, so the mesh stays closed whatever is decided inside. Where
+//! one of the creases only skims the cell (its line misses the cell, or only off the surface),
+//! the other crease's centre alone is fanned to the whole polygon.
 //!
 //! Where the face is so narrow that no grid edge of the cell crosses it, the cell sees only the
 //! two sides and solves their planes' line, which lies off the face: the fan cuts it off, half a
@@ -31,7 +33,8 @@ use super::placement::{line_in_box, Component, GROWTH, INSET};
 use crate::grid::in_box;
 use glam::Vec3;
 
-/// Two centres, one on each crease, and the sheet each polygon vertex was taken on.
+/// Two centres, one on each crease (or one, where the other crease skims the cell), and the
+/// triangles between them and the polygon.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Strip {
     /// On the crease between the first side and the middle face, and on the one between the
