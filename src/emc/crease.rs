@@ -32,24 +32,19 @@ const KEPT: f32 = 0.8;
 /// to walk the surface in: their mean normal is shorter than this, and the crease is kept.
 const MIN_MEAN: f32 = 0.2;
 
-/// `true` where every walked pair of crossings with normals less alike than `theta_sharp` is
-/// joined by a surface without a jump past it at 1/32 of their distance; `false` where one keeps
-/// a jump, or where the sampler cannot walk the surface (stored and sampled inputs: the paper's
-/// test stands there).
-pub fn smooth_at_fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSampler, theta_sharp: f32) -> bool {
-    fine_scale(pts, nrm, sampler, theta_sharp).smooth
-}
-
-/// What [`smooth_at_fine_scale`] saw: whether the surface is smooth, and a point of the surface
-/// (with its normal) that a walk met between two crossings and that turns past θ against both:
-/// a face between two creases too narrow for the cell's crossings to land on (see
-/// [`super::strip`]).
+/// What [`fine_scale`] saw. `smooth`: every walked pair of crossings with normals less alike
+/// than θ is joined by a surface without a jump past it at 1/32 of their distance (`false` where
+/// one keeps a jump, or where the sampler cannot walk the surface: stored and sampled inputs, where
+/// the paper's test stands). `between`: a point of the surface (with its normal) that a walk met
+/// between two crossings and that turns past θ against both: a face between two creases too
+/// narrow for the cell's crossings to land on (see [`super::strip`]).
 pub struct FineScale {
     pub smooth: bool,
     pub between: Option<(Vec3, Vec3)>,
 }
 
-/// [`smooth_at_fine_scale`], with the face between the walked crossings where one was met.
+/// Whether a sharp component's crossings `pts` (normals `nrm`) are joined smoothly at the fine
+/// scale, and the face between the walked crossings where one was met.
 pub fn fine_scale(pts: &[Vec3], nrm: &[Vec3], sampler: &dyn EdgeSampler, theta_sharp: f32) -> FineScale {
     let mut pairs: Vec<(f32, usize, usize)> = Vec::new();
     for i in 0..nrm.len() {
@@ -98,7 +93,7 @@ pub fn two_sheet_crease(
 
 /// Whether the surface between crossings `a` and `b` (point, unit normal) bends without a jump
 /// past `theta_sharp` at 1/32 of their distance; `None` where it cannot be walked (see
-/// [`smooth_at_fine_scale`]).
+/// [`fine_scale`]).
 pub fn path_is_smooth(
     a: (Vec3, Vec3),
     b: (Vec3, Vec3),
@@ -209,7 +204,7 @@ mod tests {
         let (a, b) = (on_circle(1.0, -30.0), on_circle(1.0, 30.0));
         assert!(a.1.dot(b.1) < 0.9, "the case this is for");
         assert_eq!(path_is_smooth(a, b, &sampler, 0.9), Some(true));
-        assert!(smooth_at_fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9));
+        assert!(fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9).smooth);
     }
 
     /// Two planes meeting at 40° (normals 40° apart): the jump stays whole at every halving.
@@ -225,7 +220,7 @@ mod tests {
         let b = (Vec3::new(crease_x, 0.3, 0.2) + along * 0.5, n2);
         assert!(field(b.0).abs() < 1e-5);
         assert_eq!(path_is_smooth(a, b, &sampler, 0.9), Some(false));
-        assert!(!smooth_at_fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9));
+        assert!(!fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9).smooth);
     }
 
     /// Without a function behind the crossings the paper's test stands.
@@ -235,7 +230,7 @@ mod tests {
         let grid = crate::grid::Grid::with_resolution(Vec3::ZERO, Vec3::ONE, 1).unwrap();
         let sampler = crate::emc::edges::SampleInterpolation { values: &values, grid: &grid };
         let (a, b) = (on_circle(1.0, -30.0), on_circle(1.0, 30.0));
-        assert!(!smooth_at_fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9));
+        assert!(!fine_scale(&[a.0, b.0], &[a.1, b.1], &sampler, 0.9).smooth);
     }
 
     /// A flat face meeting a rounded edge tessellated in strips 0.3 cells wide, the first at 45°

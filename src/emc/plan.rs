@@ -38,12 +38,16 @@ pub(super) const EXTRA: u32 = u32::MAX;
 impl Plan<'_> {
     /// The triangles of this component's fan, as positions, if it has a feature point or a strip.
     pub fn fan_triangles(&self) -> Option<Vec<[DVec3; 3]>> {
-        let n = self.pts.len();
         if let Some((strip, _)) = &self.strip {
-            let at = |v: usize| if v < n { self.pts[v] } else { strip.centres[v - n] }.as_dvec3();
-            return Some(strip.triangles.iter().map(|t| t.map(at)).collect());
+            return Some(strip.positions(&self.pts).map(|t| t.map(|p| p.as_dvec3())).collect());
         }
+        self.feature_fan()
+    }
+
+    /// The fan around this component's feature point, as positions, if it has one.
+    fn feature_fan(&self) -> Option<Vec<[DVec3; 3]>> {
         let (f, _) = self.feature?;
+        let n = self.pts.len();
         let corner = |q: usize| [f.at.position, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3());
         Some((0..n).map(corner).collect())
     }
@@ -59,14 +63,7 @@ impl Plan<'_> {
         distance: impl Fn(Vec3) -> Option<f32>,
     ) -> bool {
         let Some((_, strip_worst)) = &self.strip else { return false };
-        let n = self.pts.len();
-        let without = match &self.feature {
-            Some((placed, _)) => {
-                let f = placed.at.position;
-                (0..n).map(|q| [f, self.pts[q], self.pts[(q + 1) % n]].map(|p| p.as_dvec3())).collect()
-            }
-            None => self.plain_triangles(positions, table, rules),
-        };
+        let without = self.feature_fan().unwrap_or_else(|| self.plain_triangles(positions, table, rules));
         *strip_worst < farthest_centroid(&without, distance)
     }
 

@@ -46,6 +46,22 @@ pub struct Strip {
     pub triangles: Vec<[usize; 3]>,
 }
 
+impl Strip {
+    /// Where vertex `v` of [`Strip::triangles`] lies, over the polygon's positions `pts`.
+    pub fn corner(&self, pts: &[Vec3], v: usize) -> Vec3 {
+        if v < pts.len() {
+            pts[v]
+        } else {
+            self.centres[v - pts.len()]
+        }
+    }
+
+    /// The triangles as positions, over the polygon's positions `pts`.
+    pub fn positions<'a>(&'a self, pts: &'a [Vec3]) -> impl Iterator<Item = [Vec3; 3]> + 'a {
+        self.triangles.iter().map(move |t| t.map(|v| self.corner(pts, v)))
+    }
+}
+
 /// A side of the strip, the middle face, or the other side.
 const FIRST: u8 = 0;
 const MIDDLE: u8 = 1;
@@ -309,15 +325,13 @@ fn faces_its_sheets(
     middle: &[(Vec3, Vec3)],
 ) -> bool {
     let n = pts.len();
-    let at = |v: usize| if v < n { pts[v] } else { strip.centres[v - n] };
     let middle_normal: Vec3 = (0..n)
         .filter(|&q| label[q] == MIDDLE)
         .map(|q| nrm[q])
         .chain(middle.iter().map(|m| m.1))
         .sum::<Vec3>()
         .normalize_or_zero();
-    strip.triangles.iter().all(|t| {
-        let [a, b, c] = t.map(at);
+    strip.triangles.iter().zip(strip.positions(pts)).all(|(t, [a, b, c])| {
         let normal = (b - a).cross(c - a);
         let scale = (b - a).length() * (c - a).length();
         // Degenerate (or NaN: the comparison fails for it too).
@@ -333,12 +347,7 @@ fn faces_its_sheets(
 /// The largest distance from the surface over the triangles' centroids; `None` where the input
 /// cannot tell.
 fn worst_distance(strip: &Strip, pts: &[Vec3], distance: &dyn Fn(Vec3) -> Option<f32>) -> Option<f32> {
-    let n = pts.len();
-    let at = |v: usize| if v < n { pts[v] } else { strip.centres[v - n] };
-    strip.triangles.iter().try_fold(0.0f32, |worst, t| {
-        let [a, b, c] = t.map(at);
-        Some(worst.max(distance((a + b + c) / 3.0)?))
-    })
+    strip.positions(pts).try_fold(0.0f32, |worst, [a, b, c]| Some(worst.max(distance((a + b + c) / 3.0)?)))
 }
 
 #[cfg(test)]
