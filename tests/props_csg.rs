@@ -402,6 +402,18 @@ fn check_dmc_quality(case: &Case) {
     );
 }
 
+/// A torus tube half a cell thick (smooth-blended with a sliced ball) at 17 cells: a cell saw
+/// both sides of the tube as a crease, and its centre stood on the line where their planes meet,
+/// 1.78 cells off the part, because a centre on its feature's line escaped the check that keeps
+/// MC's triangles where a centre lies farther off (it was off the surface all the same).
+#[test]
+fn emc_keeps_its_vertices_near_a_tube_thinner_than_a_cell_on_seed_2500531() {
+    let case = Case::new(2_500_531);
+    assert!(case.tree.text.contains("torus(0.382, 0.072)"), "the case: {}", case.describe());
+    let emc = case.mesh(Method::Emc, Topology::Fixed);
+    near(&case, "emc", &emc.mesh, 3f32.sqrt());
+}
+
 /// Mirrored cylinders 0.1 cells apart across x = 0, a grid plane at every power-of-two resolution:
 /// MC at 32, 64 and 128 cells keeps them apart, DMC (one vertex per leaf) joins them. A gap
 /// thinner than a cell is no feature the promise covers, and the grid moved by a third of a cell

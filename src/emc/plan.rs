@@ -67,8 +67,8 @@ impl Plan<'_> {
         *strip_worst < farthest_centroid(&without, distance)
     }
 
-    /// Whether this component's fan centre is an approximate one (off its feature: see
-    /// [`placement`]) that lies farther from the surface, by `distance` (an estimate, `None`
+    /// Whether this component's fan centre is an approximate one (off its feature, or on its
+    /// feature's line but off the surface: see [`placement`]) that lies farther from the surface, by `distance` (an estimate, `None`
     /// where the input cannot tell), than `slack` beyond the centroid of every one of MC's
     /// triangles of the polygon. Such a centre bends the patch away from the surface, not towards
     /// a feature: a crease or an apex in a grid plane that the cell sees only from one side (two
@@ -84,7 +84,7 @@ impl Plan<'_> {
         slack: f32,
     ) -> bool {
         let Some((placed, _)) = &self.feature else { return false };
-        if placed.at.on_feature {
+        if placed.at.is_feature_vertex() {
             return false;
         }
         let Some(centre) = distance(placed.at.position) else { return false };
