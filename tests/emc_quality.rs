@@ -580,3 +580,19 @@ fn tubes_thinner_than_a_cell_keep_their_vertices_near_the_surface() {
         assert!(worst <= 0.5 * h, "seed {seed}, {text} at {res}: a vertex {} cells off", worst / h);
     }
 }
+
+/// The gear's tooth bottoms lie in the disc's: where the disc's rim runs across a tooth's bottom
+/// face on a grid plane (at 56 and 64 cells), the union's gradient at a crossing there was the
+/// hidden rim's, and the cell's fan centre sat a quarter of a cell inside the tooth (0.25 and
+/// 0.28 cells). Crossings are probed along their normal now (`emc::edges`): 0.057 and 0.096.
+#[test]
+fn faces_flush_with_another_parts_keep_their_normals_on_the_gear() {
+    for res in [56, 64] {
+        let (scene, grid) = scene_grid("gear", res);
+        let field = scene.field.as_ref();
+        let out = emc_on(field, &grid, &EmcOptions::default());
+        let error = isoforge::mesh::analysis::surface_error(&out.mesh, field);
+        let cells = error.dist_max / grid.cell_size() as f64;
+        assert!(cells < 0.15, "at {res}: {cells} cells");
+    }
+}
