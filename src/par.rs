@@ -47,6 +47,22 @@ pub fn map<R: Send>(n: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
     (0..n).map(f).collect()
 }
 
+/// [`map`] for work that needs buffers: `f(&mut s, i)` with an `s` from `init` per run of
+/// indices one thread takes (one in all without threads), so the buffers are made a few times,
+/// not once per index.
+pub fn map_with<S, R: Send>(
+    n: usize,
+    init: impl Fn() -> S + Sync + Send,
+    f: impl Fn(&mut S, usize) -> R + Sync + Send,
+) -> Vec<R> {
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
+    if pooled() {
+        return (0..n).into_par_iter().map_init(&init, |s, i| f(s, i)).collect();
+    }
+    let mut s = init();
+    (0..n).map(|i| f(&mut s, i)).collect()
+}
+
 /// Calls `f(chunk_index, chunk)` for each `chunk_len`-long piece of `data` (the last may be
 /// shorter), in parallel where there are threads, and returns the results in chunk order.
 pub fn map_chunks_mut<T: Send, R: Send>(

@@ -273,17 +273,46 @@ pub fn triangle_table() -> &'static [CellTriangles; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|case| triangulate(&polygon_table()[case])))
 }
 
+/// The faces of `case` that are ambiguous, as a bit set over face ids.
+fn ambiguous_faces(case: u8) -> u8 {
+    (0..6).filter(|&f| face_is_ambiguous(case, f)).fold(0, |m, f| m | 1 << f)
+}
+
+/// A table over every (case, joined-faces) pair, indexed `case << 6 | joined_faces`, built from
+/// `entry` only where no bit of an unambiguous face is set; the other entries copy the one with
+/// those bits cleared (a subset, so a smaller index, already built). Most cases have no ambiguous
+/// face, so this builds 1/40 of the entries: building them all cost more than some whole meshes.
+fn table_over_joined_faces<T: Copy>(entry: impl Fn(u8, u8) -> T) -> Vec<T> {
+    let mut table: Vec<T> = Vec::with_capacity(256 * 64);
+    for case in 0..=255u8 {
+        let ambiguous = ambiguous_faces(case);
+        for joined in 0..64u8 {
+            let canonical = joined & ambiguous;
+            let value = if canonical == joined {
+                entry(case, joined)
+            } else {
+                table[(case as usize) << 6 | canonical as usize]
+            };
+            table.push(value);
+        }
+    }
+    table
+}
+
 /// Polygons for every (case, joined-faces) pair, indexed `case << 6 | joined_faces`.
 pub fn polygon_table_with_faces() -> &'static [CellPolygons] {
     static TABLE: OnceLock<Vec<CellPolygons>> = OnceLock::new();
-    TABLE.get_or_init(|| (0..256 * 64).map(|k| build_cell_polygons((k >> 6) as u8, (k & 63) as u8)).collect())
+    TABLE.get_or_init(|| table_over_joined_faces(build_cell_polygons))
 }
 
 /// Triangles for every (case, joined-faces) pair: the trilinear-topology option picks the face bits
 /// per cell with the asymptotic decider. 16 384 small entries, built on first use.
 pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
-    TABLE.get_or_init(|| polygon_table_with_faces().iter().map(triangulate).collect())
+    TABLE.get_or_init(|| {
+        let polygons = polygon_table_with_faces();
+        table_over_joined_faces(|case, joined| triangulate(&polygons[(case as usize) << 6 | joined as usize]))
+    })
 }
 
 /// [`triangle_table_with_faces`] with no [`CENTER`] vertex (a polygon that would need one is fanned
@@ -292,16 +321,33 @@ pub fn triangle_table_with_faces() -> &'static [CellTriangles] {
 pub fn triangle_table_with_faces_without_centre() -> &'static [CellTriangles] {
     static TABLE: OnceLock<Vec<CellTriangles>> = OnceLock::new();
     TABLE.get_or_init(|| {
-        polygon_table_with_faces()
-            .iter()
-            .map(|p| triangulate_with(p, triangulate_polygon_without_centre))
-            .collect()
+        let polygons = polygon_table_with_faces();
+        table_over_joined_faces(|case, joined| {
+            triangulate_with(
+                &polygons[(case as usize) << 6 | joined as usize],
+                triangulate_polygon_without_centre,
+            )
+        })
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tables_built_from_ambiguous_faces_only_equal_tables_built_entry_by_entry() {
+        let same = |a: &CellTriangles, b: &CellTriangles| {
+            a.count == b.count && a.per_polygon == b.per_polygon && a.triangles().eq(b.triangles())
+        };
+        for k in 0..256 * 64 {
+            let polygons = build_cell_polygons((k >> 6) as u8, (k & 63) as u8);
+            assert_eq!(polygon_table_with_faces()[k], polygons, "entry {k}");
+            assert!(same(&triangle_table_with_faces()[k], &triangulate(&polygons)), "entry {k}");
+            let without_centre = triangulate_with(&polygons, triangulate_polygon_without_centre);
+            assert!(same(&triangle_table_with_faces_without_centre()[k], &without_centre), "entry {k}");
+        }
+    }
 
     #[test]
     fn faces_hold_four_corners_with_a_fixed_coordinate() {

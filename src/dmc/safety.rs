@@ -28,6 +28,24 @@ use rustc_hash::FxHashMap as HashMap;
 /// A triangle of the contour named by its three dual edges (inside end, outside end).
 pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
 
+/// Buffers one thread's safety tests reuse from merge to merge: a test allocates nothing of its
+/// own, and allocation was a fifth of its time (a merge tests a few dozen dual cells).
+#[derive(Default)]
+pub struct Scratch {
+    around: Neighbourhood,
+    stack: Vec<u32>,
+    marked: Vec<([u32; 3], u8)>,
+    marks: Vec<u8>,
+    points: Vec<([u32; 3], bool)>,
+    cells_before: Vec<[VertexKey; 8]>,
+    cells_after: Vec<[VertexKey; 8]>,
+    crossings: Crossings,
+    tris_before: Vec<[u32; 3]>,
+    tris_after: Vec<[u32; 3]>,
+    boundary_before: Vec<(u32, u32)>,
+    discs: Discs,
+}
+
 /// Whether making internal node `n` (whose children are all leaves) a leaf whose vertex has value
 /// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
 pub fn merge_is_safe(
@@ -36,17 +54,33 @@ pub fn merge_is_safe(
     value: f32,
     field: &dyn Field,
     iso: f32,
+    scratch: &mut Scratch,
 ) -> Option<Vec<EdgeTriangle>> {
-    let around = Neighbourhood::of(tree, n);
+    let Scratch {
+        around,
+        stack,
+        marked,
+        marks,
+        points,
+        cells_before,
+        cells_after,
+        crossings,
+        tris_before,
+        tris_after,
+        boundary_before,
+        discs,
+    } = scratch;
+    around.fill(tree, n, stack);
     // The star's points before the merge: the children's corners and the neighbours' corners on
     // the node's closed box. After it, the children's corners that are neither the node's own nor
     // a neighbour's are no octree vertices any more; the others keep their dual cells, with every
     // child among their leaves replaced by the node. So each point's leaves are located once.
     let first = tree.nodes[n as usize].children;
     let children = first..first + 8;
-    let mut cells_before = Vec::new();
-    let mut cells_after = Vec::new();
-    for (p, kept) in star_points(tree, n, &around) {
+    cells_before.clear();
+    cells_after.clear();
+    star_points(tree, n, around, marked, marks, points);
+    for &(p, kept) in points.iter() {
         let Some(cell) = dual_cell_by(tree, p, |q| around.leaf_at(tree, q)) else { continue };
         cells_before.push(cell);
         if kept {
@@ -65,10 +99,9 @@ pub fn merge_is_safe(
     let joined = |cell: &[VertexKey; 8], case: u8| {
         super::faces::joined_faces(case, |k| dual::centre(tree, cell[k]), field, iso)
     };
-    let mut crossings =
-        Crossings { ids: HashMap::with_capacity_and_hasher(4 * cells_before.len(), Default::default()) };
-    let tris_before = star_triangles(&cells_before, &sign_before, &joined, &mut crossings);
-    let tris_after = star_triangles(&cells_after, &sign_after, &joined, &mut crossings);
+    crossings.ids.clear();
+    star_triangles(cells_before, sign_before, joined, crossings, tris_before);
+    star_triangles(cells_after, sign_after, joined, crossings, tris_after);
     let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
         let mut by_id =
             vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
@@ -80,8 +113,10 @@ pub fn merge_is_safe(
     if tris_before.is_empty() && tris_after.is_empty() {
         return Some(Vec::new());
     }
-    match (discs_boundary(&tris_before, crossings.len()), discs_boundary(&tris_after, crossings.len())) {
-        (Some(a), Some(b)) if a == b => Some(edges(&tris_after)),
+    boundary_before.clear();
+    boundary_before.extend_from_slice(discs.boundary(tris_before, crossings.len())?);
+    match discs.boundary(tris_after, crossings.len()) {
+        Some(after) if after == &boundary_before[..] => Some(edges(tris_after)),
         _ => None,
     }
 }
@@ -90,13 +125,21 @@ pub fn merge_is_safe(
 /// then x: the order that names the crossings), with whether it stays an octree vertex after the
 /// merge (a neighbour's corner or the node's own). Marked on the lattice of the node's closed box
 /// where that is small, sorted otherwise.
-fn star_points(tree: &Octree, n: u32, around: &Neighbourhood) -> Vec<([u32; 3], bool)> {
+fn star_points(
+    tree: &Octree,
+    n: u32,
+    around: &Neighbourhood,
+    marked: &mut Vec<([u32; 3], u8)>,
+    marks: &mut Vec<u8>,
+    points: &mut Vec<([u32; 3], bool)>,
+) {
     const POINT: u8 = 1;
     const KEPT: u8 = 2;
     let (lo, hi) = tree.int_box(n);
     let first = tree.nodes[n as usize].children;
     let children = first..first + 8;
-    let mut marked: Vec<([u32; 3], u8)> = Vec::with_capacity(8 * around.leaves.len() + 8);
+    marked.clear();
+    points.clear();
     for &leaf in around.leaves.iter().filter(|l| !children.contains(l)) {
         for p in corners(tree, leaf) {
             if (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]) {
@@ -110,12 +153,12 @@ fn star_points(tree: &Octree, n: u32, around: &Neighbourhood) -> Vec<([u32; 3], 
     marked.extend(corners(tree, n).map(|p| (p, KEPT)));
     let side: [u32; 3] = std::array::from_fn(|a| hi[a] - lo[a] + 1);
     let lattice = side.iter().map(|&s| s as u64).product::<u64>();
-    let mut points = Vec::new();
     if lattice <= MAPPED_CELLS as u64 {
         let index =
             |p: [u32; 3]| (((p[2] - lo[2]) * side[1] + p[1] - lo[1]) * side[0] + p[0] - lo[0]) as usize;
-        let mut marks = vec![0u8; lattice as usize];
-        for &(p, mark) in &marked {
+        marks.clear();
+        marks.resize(lattice as usize, 0);
+        for &(p, mark) in marked.iter() {
             marks[index(p)] |= mark;
         }
         for z in lo[2]..=hi[2] {
@@ -137,7 +180,6 @@ fn star_points(tree: &Octree, n: u32, around: &Neighbourhood) -> Vec<([u32; 3], 
             }
         }
     }
-    points
 }
 
 /// Lattice points (as `[u32; 3]`) of the corners of leaf `n`.
@@ -152,6 +194,7 @@ fn corners(tree: &Octree, n: u32) -> [[u32; 3]; 8] {
 /// box is small (merges near the finest level: nearly all of them) each of its finest cells is
 /// mapped to its leaf, so nothing is located from the root again; a larger box (near the top of a
 /// deep octree, mostly empty leaves) locates through the tree from the walk's start instead.
+#[derive(Default)]
 struct Neighbourhood {
     lo: [u32; 3],
     dims: [u32; 3],
@@ -168,7 +211,8 @@ struct Neighbourhood {
 const MAPPED_CELLS: u32 = 1 << 15;
 
 impl Neighbourhood {
-    fn of(tree: &Octree, n: u32) -> Neighbourhood {
+    /// The neighbourhood of node `n`, in place of the one held (`stack`: the walk's, reused).
+    fn fill(&mut self, tree: &Octree, n: u32, stack: &mut Vec<u32>) {
         let (lo, hi) = tree.int_box(n);
         let glo = lo.map(|c| c.saturating_sub(1));
         let ghi: [u32; 3] = std::array::from_fn(|a| (hi[a] + 1).min(tree.cells[a]));
@@ -176,14 +220,17 @@ impl Neighbourhood {
         let cells = dims.iter().map(|&d| d as u64).product::<u64>();
         let start = tree.common_ancestor(glo, ghi.map(|c| c - 1), NONE);
         let mapped = cells <= MAPPED_CELLS as u64;
-        let mut around = Neighbourhood {
-            lo: glo,
-            dims,
-            start,
-            leaf: if mapped { vec![NONE; cells as usize] } else { Vec::new() },
-            leaves: Vec::new(),
-        };
-        let mut stack = vec![start];
+        let around = self;
+        around.lo = glo;
+        around.dims = dims;
+        around.start = start;
+        around.leaf.clear();
+        if mapped {
+            around.leaf.resize(cells as usize, NONE);
+        }
+        around.leaves.clear();
+        stack.clear();
+        stack.push(start);
         while let Some(m) = stack.pop() {
             let (mlo, mhi) = tree.int_box(m);
             if (0..3).any(|a| mhi[a] <= glo[a] || mlo[a] >= ghi[a]) {
@@ -211,7 +258,6 @@ impl Neighbourhood {
                 }
             }
         }
-        around
     }
 
     fn index(&self, q: [u32; 3]) -> usize {
@@ -231,6 +277,7 @@ impl Neighbourhood {
 
 /// Mesh vertices of the star's contours, named by their dual edge (inside end, outside end) so that
 /// the contours before and after a merge share the names of the crossings they share.
+#[derive(Default)]
 struct Crossings {
     ids: HashMap<(VertexKey, VertexKey), u32>,
 }
@@ -250,14 +297,15 @@ impl Crossings {
 /// degenerate cell are dropped, as [`super::contour`] drops them.
 fn star_triangles(
     cells: &[[VertexKey; 8]],
-    inside: &dyn Fn(VertexKey) -> bool,
-    joined: &dyn Fn(&[VertexKey; 8], u8) -> u8,
+    inside: impl Fn(VertexKey) -> bool,
+    joined: impl Fn(&[VertexKey; 8], u8) -> u8,
     crossings: &mut Crossings,
-) -> Vec<[u32; 3]> {
+    out: &mut Vec<[u32; 3]>,
+) {
     let table = triangle_table_with_faces_without_centre();
-    let mut out = Vec::new();
+    out.clear();
     for cell in cells {
-        let signs = cell.map(inside);
+        let signs = cell.map(&inside);
         let case = signs.iter().enumerate().fold(0u8, |c, (i, &s)| c | (s as u8) << i);
         if case == 0 || case == 255 {
             continue;
@@ -273,116 +321,150 @@ fn star_triangles(
             }
         }
     }
-    out
 }
 
-/// The boundary edges (sorted pairs, sorted) of a triangle set that is a disjoint union of discs,
-/// each bounded by one loop; `None` for anything else (a closed piece, an annulus, a handle, an
-/// edge on three triangles, two pieces meeting at a point).
-fn discs_boundary(tris: &[[u32; 3]], vertices: usize) -> Option<Vec<(u32, u32)>> {
-    // The edges as sorted pairs, bucketed by their low end (a counting sort: crossing ids are
-    // small and dense) and each bucket, a handful, sorted by the high end: distinct edges in
-    // order, with their use counts, in linear time. A star is tested for every merge tried, so
-    // this is one of DMC's hottest loops.
-    let mut start = vec![0u32; vertices + 1];
-    let edge = |t: &[u32; 3], i: usize| {
-        let (a, b) = (t[i], t[(i + 1) % 3]);
-        (a.min(b), a.max(b))
-    };
-    for t in tris {
-        for i in 0..3 {
-            start[edge(t, i).0 as usize + 1] += 1;
+/// The buffers of [`Discs::boundary`], reused from star to star.
+#[derive(Default)]
+struct Discs {
+    start: Vec<u32>,
+    fill: Vec<u32>,
+    high: Vec<u32>,
+    counted: Vec<((u32, u32), u8)>,
+    boundary: Vec<(u32, u32)>,
+    pieces: UnionFind,
+    loops: UnionFind,
+    degree: Vec<u8>,
+    /// Per vertex, its piece's root (`u32::MAX`: on no triangle).
+    root: Vec<u32>,
+    euler2: Vec<i64>,
+    loop_of: Vec<u32>,
+}
+
+/// `v` cleared and filled with `n` copies of `x`.
+fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.clear();
+    v.resize(n, x);
+}
+
+impl Discs {
+    /// The boundary edges (sorted pairs, sorted) of a triangle set that is a disjoint union of
+    /// discs, each bounded by one loop; `None` for anything else (a closed piece, an annulus, a
+    /// handle, an edge on three triangles, two pieces meeting at a point).
+    fn boundary(&mut self, tris: &[[u32; 3]], vertices: usize) -> Option<&[(u32, u32)]> {
+        // The edges as sorted pairs, bucketed by their low end (a counting sort: crossing ids are
+        // small and dense) and each bucket, a handful, sorted by the high end: distinct edges in
+        // order, with their use counts, in linear time. A star is tested for every merge tried,
+        // so this is one of DMC's hottest loops.
+        let edge = |t: &[u32; 3], i: usize| {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            (a.min(b), a.max(b))
+        };
+        let start = &mut self.start;
+        reset(start, vertices + 1, 0);
+        for t in tris {
+            for i in 0..3 {
+                start[edge(t, i).0 as usize + 1] += 1;
+            }
         }
-    }
-    for v in 0..vertices {
-        start[v + 1] += start[v];
-    }
-    let mut high = vec![0u32; tris.len() * 3];
-    let mut fill = start.clone();
-    for t in tris {
-        for i in 0..3 {
-            let (lo, hi) = edge(t, i);
-            high[fill[lo as usize] as usize] = hi;
-            fill[lo as usize] += 1;
+        for v in 0..vertices {
+            start[v + 1] += start[v];
         }
-    }
-    // Distinct edges with their use counts.
-    let mut counted: Vec<((u32, u32), u8)> = Vec::with_capacity(high.len());
-    for lo in 0..vertices {
-        let bucket = &mut high[start[lo] as usize..start[lo + 1] as usize];
-        bucket.sort_unstable();
-        for &hi in bucket.iter() {
-            match counted.last_mut() {
-                Some((last, uses)) if *last == (lo as u32, hi) => {
-                    *uses += 1;
-                    if *uses > 2 {
+        reset(&mut self.high, tris.len() * 3, 0);
+        self.fill.clone_from(start);
+        for t in tris {
+            for i in 0..3 {
+                let (lo, hi) = edge(t, i);
+                self.high[self.fill[lo as usize] as usize] = hi;
+                self.fill[lo as usize] += 1;
+            }
+        }
+        // Distinct edges with their use counts.
+        let counted = &mut self.counted;
+        counted.clear();
+        for lo in 0..vertices {
+            let bucket = &mut self.high[start[lo] as usize..start[lo + 1] as usize];
+            bucket.sort_unstable();
+            for &hi in bucket.iter() {
+                match counted.last_mut() {
+                    Some((last, uses)) if *last == (lo as u32, hi) => {
+                        *uses += 1;
+                        if *uses > 2 {
+                            return None;
+                        }
+                    }
+                    _ => counted.push(((lo as u32, hi), 1)),
+                }
+            }
+        }
+        // Pieces (joined through shared vertices), each vertex's found once; per piece twice its
+        // Euler characteristic, 2V - F - L: a piece's E is (3F + L) / 2 with L boundary edges.
+        let pieces = &mut self.pieces;
+        pieces.reset(vertices);
+        for t in tris {
+            pieces.union(t[0], t[1]);
+            pieces.union(t[1], t[2]);
+        }
+        let (root, euler2) = (&mut self.root, &mut self.euler2);
+        reset(root, vertices, u32::MAX);
+        reset(euler2, vertices, 0);
+        for t in tris {
+            for &v in t {
+                if root[v as usize] == u32::MAX {
+                    root[v as usize] = pieces.find(v);
+                    euler2[root[v as usize] as usize] += 2;
+                }
+            }
+            euler2[root[t[0] as usize] as usize] -= 1;
+        }
+        self.boundary.clear();
+        self.boundary.extend(counted.iter().filter(|(_, u)| *u == 1).map(|&(e, _)| e));
+        let degree = &mut self.degree;
+        reset(degree, vertices, 0);
+        self.loops.reset(vertices);
+        for &(a, b) in &self.boundary {
+            degree[a as usize] += 1;
+            degree[b as usize] += 1;
+            self.loops.union(a, b);
+            euler2[root[a as usize] as usize] -= 1;
+        }
+        // Per piece (by root): the boundary loop seen (u32::MAX: none).
+        let loop_of = &mut self.loop_of;
+        reset(loop_of, vertices, u32::MAX);
+        for v in 0..vertices {
+            if root[v] == u32::MAX {
+                continue;
+            }
+            match degree[v] {
+                0 => {}
+                2 => {
+                    let (piece, l) = (root[v] as usize, self.loops.find(v as u32));
+                    if loop_of[piece] == u32::MAX {
+                        loop_of[piece] = l;
+                    } else if loop_of[piece] != l {
                         return None;
                     }
                 }
-                _ => counted.push(((lo as u32, hi), 1)),
+                _ => return None,
             }
         }
-    }
-    let mut pieces = UnionFind::new(vertices);
-    for t in tris {
-        pieces.union(t[0], t[1]);
-        pieces.union(t[1], t[2]);
-    }
-    let boundary: Vec<(u32, u32)> = counted.iter().filter(|(_, u)| *u == 1).map(|&(e, _)| e).collect();
-    let mut degree = vec![0u8; vertices];
-    let mut loops = UnionFind::new(vertices);
-    for &(a, b) in &boundary {
-        degree[a as usize] += 1;
-        degree[b as usize] += 1;
-        loops.union(a, b);
-    }
-    // Per piece (by root): V - E + F, and a boundary loop seen (u32::MAX: none; u32::MAX - 1: two).
-    let mut euler = vec![0i64; vertices];
-    let mut in_tris = vec![false; vertices];
-    for t in tris {
-        euler[pieces.find(t[0]) as usize] += 1;
-        for &v in t {
-            if !std::mem::replace(&mut in_tris[v as usize], true) {
-                euler[pieces.find(v) as usize] += 1;
+        for v in 0..vertices {
+            if root[v] == v as u32 && (euler2[v] != 2 || loop_of[v] == u32::MAX) {
+                return None;
             }
         }
+        Some(&self.boundary)
     }
-    for &((a, _), _) in &counted {
-        euler[pieces.find(a) as usize] -= 1;
-    }
-    let mut loop_of = vec![u32::MAX; vertices];
-    for v in 0..vertices as u32 {
-        if !in_tris[v as usize] {
-            continue;
-        }
-        match degree[v as usize] {
-            0 => {}
-            2 => {
-                let (piece, l) = (pieces.find(v) as usize, loops.find(v));
-                if loop_of[piece] == u32::MAX {
-                    loop_of[piece] = l;
-                } else if loop_of[piece] != l {
-                    return None;
-                }
-            }
-            _ => return None,
-        }
-    }
-    for v in 0..vertices {
-        if in_tris[v] && pieces.find(v as u32) as usize == v && (euler[v] != 1 || loop_of[v] == u32::MAX) {
-            return None;
-        }
-    }
-    Some(boundary)
 }
 
+#[derive(Default)]
 struct UnionFind {
     parent: Vec<u32>,
 }
 
 impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind { parent: (0..n as u32).collect() }
+    fn reset(&mut self, n: usize) {
+        self.parent.clear();
+        self.parent.extend(0..n as u32);
     }
 
     fn find(&mut self, mut x: u32) -> u32 {

@@ -10,7 +10,7 @@
 use super::build::place;
 use super::fidelity::Fidelity;
 use super::qef::Qef;
-use super::safety::merge_is_safe;
+use super::safety::{merge_is_safe, Scratch};
 use super::tree::{Kind, Octree};
 use crate::field::Field;
 use glam::Vec3;
@@ -158,9 +158,9 @@ pub fn simplify(
             }
             let tested = {
                 let tree = &*tree;
-                crate::par::map(members.len(), |k| {
+                crate::par::map_with(members.len(), Scratch::default, |scratch, k| {
                     let i = members[k];
-                    merge_is_safe(tree, candidates[i].node, values[i], field, iso)
+                    merge_is_safe(tree, candidates[i].node, values[i], field, iso, scratch)
                 })
             };
             let mut safe = Vec::new();
