@@ -167,7 +167,7 @@ impl Samples<'_> {
 /// One entry per grid point, starting at `blank`, with `paint(payload, entry)` called for every
 /// box `(lo, hi, payload)` in order on the entry of every point the closed box `lo..=hi` (point
 /// indices) holds, in pieces of point layers on the threads.
-fn paint_boxes<T: Copy + Send + Sync, P: Copy + Sync>(
+fn paint_boxes<T: Copy + Default + Send + Sync, P: Copy + Sync>(
     grid: &Grid,
     boxes: &[([usize; 3], [usize; 3], P)],
     blank: T,
@@ -175,32 +175,38 @@ fn paint_boxes<T: Copy + Send + Sync, P: Copy + Sync>(
 ) -> Vec<T> {
     let [nx, ny, _] = grid.points();
     let layer = nx * ny;
-    let mut entries = vec![blank; grid.point_count()];
+    // Allocated zeroed (the system hands out zero pages untouched) and blanked piece by piece on
+    // the threads: filled with `blank` here, the whole grid's pages were first touched on one
+    // thread, which at 256 cells was most of the painting and kept it from scaling.
+    let mut entries = vec![T::default(); grid.point_count()];
     crate::par::map_chunks_mut(&mut entries, APPLY_LAYERS * layer, |c, entries| {
+        entries.fill(blank);
         let first = c * APPLY_LAYERS;
         for &(lo, hi, payload) in boxes {
-            for_points(grid, lo, hi, first, entries.len() / layer, |n| paint(payload, &mut entries[n]));
+            for_rows(grid, lo, hi, first, entries.len() / layer, |row| {
+                entries[row].iter_mut().for_each(|e| paint(payload, e))
+            });
         }
     });
     entries
 }
 
-/// Calls `f` with the index, counted from point layer `first`, of every point of the closed box
-/// `lo..=hi` (point indices) that lies in the `layers` point layers from `first`.
-fn for_points(
+/// Calls `f` with the index range, counted from point layer `first`, of every row of points
+/// (along x) of the closed box `lo..=hi` (point indices) that lies in the `layers` point layers
+/// from `first`: a row is contiguous, so painting it is one pass over a slice.
+fn for_rows(
     grid: &Grid,
     lo: [usize; 3],
     hi: [usize; 3],
     first: usize,
     layers: usize,
-    mut f: impl FnMut(usize),
+    mut f: impl FnMut(std::ops::Range<usize>),
 ) {
     let start = grid.index(0, 0, first);
     for k in lo[2].max(first)..=hi[2].min(first + layers - 1) {
         for j in lo[1]..=hi[1] {
-            for i in lo[0]..=hi[0] {
-                f(grid.index(i, j, k) - start);
-            }
+            let row = grid.index(lo[0], j, k) - start;
+            f(row..row + hi[0] - lo[0] + 1);
         }
     }
 }
