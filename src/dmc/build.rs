@@ -107,20 +107,28 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
         crate::field::values_and_gradients_or_differences(field, &points, spacing * 1e-2);
 
     let per_cell = samples_per_cell.pow(3);
+    // Each crust cell's QEF and its minimiser (an SVD) are its own, so the cells go to the
+    // threads and are stored in order: the same vertices on any count.
+    let placed = {
+        let tree = &*tree;
+        crate::par::map(crust.len(), |i| {
+            let (lo, hi) = tree.world_box(crust[i]);
+            let mut qef = Qef::new((lo + hi) * 0.5);
+            for &s in &cell_samples[i * per_cell..(i + 1) * per_cell] {
+                let (v, g) = (values[s as usize], gradients[s as usize]);
+                if v.is_finite() && g.is_finite() {
+                    qef.add(points[s as usize], v - iso, g);
+                }
+            }
+            let placed = place(&qef, lo, hi);
+            (qef, placed, (lo + hi) * 0.5)
+        })
+    };
     let mut vertices = Vec::with_capacity(crust.len());
     let mut free = Vec::with_capacity(crust.len());
     let mut centres = Vec::with_capacity(crust.len());
-    for (i, &n) in crust.iter().enumerate() {
-        let (lo, hi) = tree.world_box(n);
-        centres.push((lo + hi) * 0.5);
-        let mut qef = Qef::new((lo + hi) * 0.5);
-        for &s in &cell_samples[i * per_cell..(i + 1) * per_cell] {
-            let (v, g) = (values[s as usize], gradients[s as usize]);
-            if v.is_finite() && g.is_finite() {
-                qef.add(points[s as usize], v - iso, g);
-            }
-        }
-        let placed = place(&qef, lo, hi);
+    for (&n, (qef, placed, centre)) in crust.iter().zip(placed) {
+        centres.push(centre);
         vertices.push(placed.vertex);
         free.push(placed.free);
         tree.nodes[n as usize].qef = tree.qefs.len() as u32;
