@@ -68,9 +68,9 @@ impl Plan<'_> {
     }
 
     /// Whether this component's fan centre is an approximate one (off its feature, or on its
-    /// feature's line but off the surface: see [`placement`]) that lies farther from the surface, by `distance` (an estimate, `None`
-    /// where the input cannot tell), than `slack` beyond the centroid of every one of MC's
-    /// triangles of the polygon. Such a centre bends the patch away from the surface, not towards
+    /// feature's line but off the surface: see [`placement`]) that lies farther from the
+    /// surface, by `distance` (an estimate, `None` where the input cannot tell), than `slack`
+    /// beyond the centroid of every one of MC's triangles of the polygon. Such a centre bends the patch away from the surface, not towards
     /// a feature: a crease or an apex in a grid plane that the cell sees only from one side (two
     /// boxes' faces on grid planes), where its fan stood up to 166° off the surface. On the scenes
     /// at 32–96 cells this changes the rocket and the gyroid only, each max distance the same or
