@@ -22,6 +22,7 @@
 use super::dual::{self, dual_cell_by, VertexKey};
 use super::tree::{Kind, Octree, NONE};
 use crate::field::Field;
+use crate::mesh::analysis::topology::UnionFind;
 use crate::tables::{triangle_table_with_faces_without_centre, EDGES};
 use rustc_hash::FxHashMap as HashMap;
 
@@ -453,33 +454,5 @@ impl Discs {
             }
         }
         Some(&self.boundary)
-    }
-}
-
-#[derive(Default)]
-struct UnionFind {
-    parent: Vec<u32>,
-}
-
-impl UnionFind {
-    fn reset(&mut self, n: usize) {
-        self.parent.clear();
-        self.parent.extend(0..n as u32);
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let up = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = up;
-            x = up;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra as usize] = rb;
-        }
     }
 }

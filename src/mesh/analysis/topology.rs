@@ -232,6 +232,7 @@ fn link_is_path_or_cycle(link: &[(u32, u32)], nodes: &mut Vec<u32>) -> bool {
 }
 
 /// Disjoint sets over `0..n` with path halving (union by index keeps it short enough here).
+#[derive(Default)]
 pub(crate) struct UnionFind {
     parent: Vec<u32>,
 }
@@ -239,6 +240,12 @@ pub(crate) struct UnionFind {
 impl UnionFind {
     pub(crate) fn new(n: usize) -> Self {
         UnionFind { parent: (0..n as u32).collect() }
+    }
+
+    /// Back to `n` singletons, keeping the allocation (for callers that use one per query).
+    pub(crate) fn reset(&mut self, n: usize) {
+        self.parent.clear();
+        self.parent.extend(0..n as u32);
     }
 
     pub(crate) fn find(&mut self, mut x: u32) -> u32 {
