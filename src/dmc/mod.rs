@@ -175,13 +175,14 @@ fn contour_cells(
     iso: f32,
     tolerance: f32,
     cache: &mut contour::RootCache,
+    history: &mut slivers::History,
 ) -> (contour::Contour, slivers::Improved) {
     let mut vertices = DualVertices::default();
     let cells: Vec<[u32; 8]> = keys.iter().map(|cell| cell.map(|k| vertices.id(tree, k))).collect();
     vertices.evaluate(field, iso);
     let mut contour = contour::contour(&cells, &vertices, field, iso, cache);
     slivers::collapse(&mut contour, &vertices, tree.h);
-    let improved = slivers::improve(&mut contour, field, iso, tolerance, tree.h);
+    let improved = slivers::improve(&mut contour, field, iso, tolerance, tree.h, history);
     (contour, improved)
 }
 
@@ -245,7 +246,9 @@ pub fn mesh_field(
     let mut moves = vec![0u8; tree.nodes.len()];
     let mut origins = rustc_hash::FxHashMap::default();
     let mut roots = contour::RootCache::default();
-    let (mut contour, mut improved) = contour_cells(&tree, &keys, field, iso, tolerance, &mut roots);
+    let mut history = slivers::History::default();
+    let (mut contour, mut improved) =
+        contour_cells(&tree, &keys, field, iso, tolerance, &mut roots, &mut history);
     stats.contour_ms = ms_since(t);
     let t = Instant::now();
     for round in 0..=untangle::ROUNDS {
@@ -269,7 +272,7 @@ pub fn mesh_field(
             dual::for_each_mixed_cell(&tree, |cell| keys.push(*cell));
             stats.dual_cells = keys.len();
         }
-        (contour, improved) = contour_cells(&tree, &keys, field, iso, tolerance, &mut roots);
+        (contour, improved) = contour_cells(&tree, &keys, field, iso, tolerance, &mut roots, &mut history);
     }
     stats.improved = improved;
     let mut mesh = contour.mesh;

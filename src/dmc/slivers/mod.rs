@@ -23,6 +23,10 @@
 //!    ([`super::DmcStats::improved`]); it cannot be avoided by placing the dual vertices
 //!    differently, for the reason above.
 
+mod replay;
+
+pub use replay::History;
+
 use super::contour::{Contour, DualVertices};
 use crate::mesh::analysis;
 
@@ -109,6 +113,9 @@ pub struct Improved {
     /// them.
     pub bad_before: usize,
     pub left: usize,
+    /// Of the collapses and flips, those redone from the previous run's [`History`] without
+    /// searching (see [`improve`]).
+    pub replayed: usize,
 }
 
 type Corners = [glam::DVec3; 3];
@@ -180,6 +187,9 @@ struct Work<'a> {
     faces_of: Vec<Vec<u32>>,
     fixed: Vec<bool>,
     nearby: crate::mesh::buckets::TriangleBuckets,
+    /// The changes applied so far, as (old triangle, new triangle or `None`) per face, and whether
+    /// it was a flip.
+    log: Vec<(replay::Logged, bool)>,
 }
 
 impl Work<'_> {
@@ -386,7 +396,8 @@ impl Work<'_> {
         Some(vec![(f, Some([a, d, c])), (g, Some([b, c, d]))])
     }
 
-    fn apply(&mut self, change: &[(u32, Option<[u32; 3]>)]) {
+    fn apply(&mut self, change: &[(u32, Option<[u32; 3]>)], flip: bool) {
+        self.log.push((change.iter().map(|&(f, t)| (self.triangles[f as usize], t)).collect(), flip));
         for &(f, t) in change {
             let old = self.triangles[f as usize];
             if t == Some(old) {
@@ -427,6 +438,12 @@ impl Work<'_> {
     }
 }
 
+/// The side of the cubes in which triangles are found near a change: two finest cells, about a
+/// triangle's size.
+fn near_cube(h: f32) -> f64 {
+    2.0 * h as f64
+}
+
 /// Removes the bad triangles Marching Cubes leaves in the dual cells, by collapsing edges and
 /// flipping them: slivers (an angle under [`SLIVER_DEG`]), spikes (turned more than
 /// [`SPIKE_DEG`] from the surface at every corner) and specks (an edge under [`SHORT_EDGE`]).
@@ -445,12 +462,20 @@ impl Work<'_> {
 ///
 /// **Why it is bounded.** At most [`PASSES`] passes over the bad triangles, each change removing
 /// a vertex or replacing two triangles by better ones; the caller reports what it did.
+///
+/// **Contouring again.** Untangling contours the whole octree again after moving a few vertices,
+/// so most of the mesh is the one the previous run improved. `history` holds that run's start
+/// and its changes: those whose triangles, and every triangle around their vertices, are the same
+/// here are made again in their order without the search for the best change, each checked
+/// again for crossings (the one check that looks beyond those triangles); the passes then take
+/// what is left. `history` then holds this run.
 pub fn improve(
     contour: &mut Contour,
     field: &dyn crate::field::Field,
     iso: f32,
     tolerance: f32,
     h: f32,
+    history: &mut History,
 ) -> Improved {
     let mesh = &contour.mesh;
     let n = mesh.positions.len();
@@ -486,18 +511,17 @@ pub fn improve(
         faces_of,
         fixed,
         nearby: crate::mesh::buckets::TriangleBuckets::build(
-            2.0 * h as f64,
+            near_cube(h),
             mesh.triangles
                 .iter()
                 .map(|t| crate::mesh::buckets::bounds(&t.map(|v| mesh.positions[v as usize].as_dvec3()))),
         ),
+        log: Vec::new(),
     };
-    let mut out = Improved::default();
-    for pass in 0..PASSES {
+    let mut out = Improved { bad_before: work.bad_faces().len(), ..Improved::default() };
+    out.replayed = replay::replay(&mut work, history, near_cube(h));
+    for _ in 0..PASSES {
         let bad = work.bad_faces();
-        if pass == 0 {
-            out.bad_before = bad.len();
-        }
         let mut changed = 0;
         for &(_, f) in &bad {
             if !work.alive[f as usize] || !work.shape(work.triangles[f as usize]).bad {
@@ -525,13 +549,8 @@ pub fn improve(
             if let Some((_, change, flip)) =
                 options.into_iter().find(|(_, change, _)| work.clear(change) && work.near_surface(change))
             {
-                work.apply(&change);
+                work.apply(&change, flip);
                 changed += 1;
-                if flip {
-                    out.flips += 1;
-                } else {
-                    out.collapses += 1;
-                }
             }
         }
         if changed == 0 {
@@ -539,6 +558,14 @@ pub fn improve(
         }
     }
     out.left = work.bad_faces().len();
+    for (_, flip) in &work.log {
+        if *flip {
+            out.flips += 1;
+        } else {
+            out.collapses += 1;
+        }
+    }
+    *history = History::new(&mesh.positions, &mesh.triangles, std::mem::take(&mut work.log));
     let mut triangles = Vec::with_capacity(work.triangles.len());
     let mut cells = Vec::with_capacity(work.triangles.len());
     for (f, t) in work.triangles.iter().enumerate() {
