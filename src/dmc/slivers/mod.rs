@@ -187,6 +187,8 @@ struct Work<'a> {
     faces_of: Vec<Vec<u32>>,
     fixed: Vec<bool>,
     nearby: crate::mesh::buckets::TriangleBuckets,
+    /// A buffer for the triangles near a new one.
+    candidates: Vec<u32>,
     /// The changes applied so far, as (old triangle, new triangle or `None`) per face, and whether
     /// it was a flip.
     log: Vec<(replay::Logged, bool)>,
@@ -229,11 +231,10 @@ impl Work<'_> {
         let (mut before, mut after) = (Summary::new(), Summary::new());
         for &(f, t) in change {
             let old = self.triangles[f as usize];
-            let shape = self.shape(old);
             if t == Some(old) {
                 continue;
             }
-            before.add(shape);
+            before.add(self.shape(old));
             if let Some(t) = t {
                 after.add(self.shape(t));
             }
@@ -250,7 +251,14 @@ impl Work<'_> {
     /// Whether no new triangle of `change` crosses or folds onto a triangle nearby (the costly
     /// part of the checks, asked of the best changes first).
     fn clear(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
-        let mut candidates = Vec::new();
+        let mut candidates = std::mem::take(&mut self.candidates);
+        let clear = self.clear_with(change, &mut candidates);
+        self.candidates = candidates;
+        clear
+    }
+
+    /// [`Work::clear`] with a buffer for the triangles nearby.
+    fn clear_with(&mut self, change: &[(u32, Option<[u32; 3]>)], candidates: &mut Vec<u32>) -> bool {
         for &(f, t) in change {
             let Some(t) = t else { continue };
             if t == self.triangles[f as usize] {
@@ -258,19 +266,18 @@ impl Work<'_> {
             }
             let c = self.corners(t);
             candidates.clear();
-            self.near(&c, &mut candidates);
+            self.near(&c, candidates);
             candidates.retain(|&g| !change.iter().any(|&(f, _)| f == g));
-            let mut others: Vec<[u32; 3]> = candidates.iter().map(|&g| self.triangles[g as usize]).collect();
-            others.extend(change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t));
+            let nearby = candidates.iter().map(|&g| self.triangles[g as usize]);
+            let others = nearby.chain(change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t));
             for u in others {
                 let d = self.corners(u);
                 if crate::mesh::analysis::self_intersect::indexed_pair_intersects((t, c), (u, d)) {
                     return false;
                 }
                 // Neighbours across an edge: not folded onto each other.
-                let shared: Vec<usize> = (0..3).filter(|&i| u.contains(&t[i])).collect();
-                if shared.len() == 2 {
-                    let (i, j) = (shared[0], shared[1]);
+                let mut shared = (0..3).filter(|&i| u.contains(&t[i]));
+                if let (Some(i), Some(j), None) = (shared.next(), shared.next(), shared.next()) {
                     let Some(x) = u.iter().position(|v| !t.contains(v)) else { continue };
                     let o = c[i];
                     if crate::mesh::analysis::tri_tri::folded_across_edge(
@@ -516,6 +523,7 @@ pub fn improve(
                 .iter()
                 .map(|t| crate::mesh::buckets::bounds(&t.map(|v| mesh.positions[v as usize].as_dvec3()))),
         ),
+        candidates: Vec::new(),
         log: Vec::new(),
     };
     let mut out = Improved { bad_before: work.bad_faces().len(), ..Improved::default() };
