@@ -125,54 +125,107 @@ impl Bvh {
         }
         let mut stack = vec![(0u32, 0u32)];
         let mut popped = 0usize;
-        while let Some((a, b)) = stack.pop() {
+        while let Some(pair) = stack.pop() {
             popped += 1;
             if popped % PAIRS_PER_TICK == 0 {
                 tick()?;
             }
-            let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
-            if a == b {
-                if na.count > 0 {
-                    let leaf = self.leaf_items(&na);
-                    for (k, &i) in leaf.iter().enumerate() {
-                        for &j in &leaf[k + 1..] {
-                            if boxes[i as usize].overlaps(&boxes[j as usize]) {
-                                visit(i, j);
-                            }
+            self.step(pair, boxes, &mut visit, |p| stack.push(p));
+        }
+        Ok(())
+    }
+
+    /// The pairs `(i, j)` of overlapping boxes for which `keep(i, j)` holds, each unordered pair
+    /// once, in no particular order, found on the threads: the node pairs near the root are
+    /// walked here until there are a few per thread, then each is walked on its own.
+    pub fn overlapping_pairs_par(
+        &self,
+        boxes: &[Aabb],
+        keep: impl Fn(u32, u32) -> bool + Sync,
+    ) -> Vec<(u32, u32)> {
+        let mut found = Vec::new();
+        if self.nodes.is_empty() {
+            return found;
+        }
+        let wanted = 16 * crate::par::threads();
+        let mut frontier = std::collections::VecDeque::from([(0u32, 0u32)]);
+        while frontier.len() < wanted {
+            let Some(pair) = frontier.pop_front() else { break };
+            let keep_pair = |i, j| {
+                if keep(i, j) {
+                    found.push((i, j));
+                }
+            };
+            self.step(pair, boxes, keep_pair, |p| frontier.push_back(p));
+        }
+        let frontier: Vec<(u32, u32)> = frontier.into();
+        let pieces = crate::par::map(frontier.len(), |k| {
+            let mut out = Vec::new();
+            let mut stack = vec![frontier[k]];
+            while let Some(pair) = stack.pop() {
+                let keep_pair = |i, j| {
+                    if keep(i, j) {
+                        out.push((i, j));
+                    }
+                };
+                self.step(pair, boxes, keep_pair, |p| stack.push(p));
+            }
+            out
+        });
+        found.extend(pieces.into_iter().flatten());
+        found
+    }
+
+    /// One node pair of the walk: `visit(i, j)` for the overlapping boxes of two leaves (or of
+    /// one leaf with itself), `push` for the node pairs to walk next.
+    fn step(
+        &self,
+        (a, b): (u32, u32),
+        boxes: &[Aabb],
+        mut visit: impl FnMut(u32, u32),
+        push: impl FnMut((u32, u32)),
+    ) {
+        let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
+        if a == b {
+            if na.count > 0 {
+                let leaf = self.leaf_items(&na);
+                for (k, &i) in leaf.iter().enumerate() {
+                    for &j in &leaf[k + 1..] {
+                        if boxes[i as usize].overlaps(&boxes[j as usize]) {
+                            visit(i, j);
                         }
                     }
+                }
+            } else {
+                let (l, r) = (a + 1, na.first_or_right);
+                [(l, l), (r, r), (l, r)].into_iter().for_each(push);
+            }
+            return;
+        }
+        if !na.bounds.overlaps(&nb.bounds) {
+            return;
+        }
+        match (na.count > 0, nb.count > 0) {
+            (true, true) => {
+                for &i in self.leaf_items(&na) {
+                    for &j in self.leaf_items(&nb) {
+                        if boxes[i as usize].overlaps(&boxes[j as usize]) {
+                            visit(i, j);
+                        }
+                    }
+                }
+            }
+            // Descend the inner node; of two inner nodes, the one with the larger box.
+            (false, true) => [(a + 1, b), (na.first_or_right, b)].into_iter().for_each(push),
+            (true, false) => [(a, b + 1), (a, nb.first_or_right)].into_iter().for_each(push),
+            (false, false) => {
+                if half_area(&na.bounds) >= half_area(&nb.bounds) {
+                    [(a + 1, b), (na.first_or_right, b)].into_iter().for_each(push);
                 } else {
-                    let (l, r) = (a + 1, na.first_or_right);
-                    stack.extend([(l, l), (r, r), (l, r)]);
-                }
-                continue;
-            }
-            if !na.bounds.overlaps(&nb.bounds) {
-                continue;
-            }
-            match (na.count > 0, nb.count > 0) {
-                (true, true) => {
-                    for &i in self.leaf_items(&na) {
-                        for &j in self.leaf_items(&nb) {
-                            if boxes[i as usize].overlaps(&boxes[j as usize]) {
-                                visit(i, j);
-                            }
-                        }
-                    }
-                }
-                // Descend the inner node; of two inner nodes, the one with the larger box.
-                (false, true) => stack.extend([(a + 1, b), (na.first_or_right, b)]),
-                (true, false) => stack.extend([(a, b + 1), (a, nb.first_or_right)]),
-                (false, false) => {
-                    if half_area(&na.bounds) >= half_area(&nb.bounds) {
-                        stack.extend([(a + 1, b), (na.first_or_right, b)]);
-                    } else {
-                        stack.extend([(a, b + 1), (a, nb.first_or_right)]);
-                    }
+                    [(a, b + 1), (a, nb.first_or_right)].into_iter().for_each(push);
                 }
             }
         }
-        Ok(())
     }
 
     /// Depth-first walk for queries against one object (a ray, a point): `key(state, bounds)` is
@@ -269,6 +322,15 @@ mod tests {
                 }
             }
             assert_eq!(found, expected, "n = {n}");
+            let mut on_threads: Vec<(u32, u32)> = bvh
+                .overlapping_pairs_par(&b, |_, _| true)
+                .into_iter()
+                .map(|(i, j)| (i.min(j), i.max(j)))
+                .collect();
+            on_threads.sort_unstable();
+            assert_eq!(on_threads, expected, "n = {n}, on the threads");
+            let odd = bvh.overlapping_pairs_par(&b, |i, j| (i + j) % 2 == 1);
+            assert_eq!(odd.len(), expected.iter().filter(|&&(i, j)| (i + j) % 2 == 1).count(), "n = {n}");
             if n == 400 {
                 assert!(expected.len() > 100, "the test needs overlaps to mean anything");
             }

@@ -30,8 +30,31 @@ pub fn self_intersections(mesh: &Mesh) -> usize {
 
 /// The intersecting pairs `[i, j]` (triangle indices, `i < j`), sorted: for highlighting them.
 pub fn self_intersecting_pairs(mesh: &Mesh) -> Vec<[u32; 2]> {
-    let Ok(pairs) = pairs_until(mesh, || Ok::<(), std::convert::Infallible>(()));
+    let (ids, boxes) = candidates(mesh);
+    let intersect =
+        |i: u32, j: u32| triangle_pair_intersects(mesh, ids[i as usize] as usize, ids[j as usize] as usize);
+    let mut pairs: Vec<[u32; 2]> = Bvh::build(&boxes)
+        .overlapping_pairs_par(&boxes, intersect)
+        .into_iter()
+        .map(|(i, j)| {
+            let (s, t) = (ids[i as usize], ids[j as usize]);
+            [s.min(t), s.max(t)]
+        })
+        .collect();
+    pairs.sort_unstable();
     pairs
+}
+
+/// The triangles that are not collapsed (no repeated index), and their boxes.
+fn candidates(mesh: &Mesh) -> (Vec<u32>, Vec<Aabb>) {
+    let ids: Vec<u32> = (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            let [a, b, c] = mesh.triangles[t as usize];
+            a != b && b != c && a != c
+        })
+        .collect();
+    let boxes = ids.iter().map(|&t| Aabb::of_points(&mesh.corners(t as usize))).collect();
+    (ids, boxes)
 }
 
 /// [`self_intersecting_pairs`] with a [`checkpoint`](crate::progress::checkpoint) every few
@@ -52,13 +75,7 @@ pub fn self_intersecting_pairs_within(
 }
 
 fn pairs_until<E>(mesh: &Mesh, tick: impl FnMut() -> Result<(), E>) -> Result<Vec<[u32; 2]>, E> {
-    let ids: Vec<u32> = (0..mesh.triangles.len() as u32)
-        .filter(|&t| {
-            let [a, b, c] = mesh.triangles[t as usize];
-            a != b && b != c && a != c
-        })
-        .collect();
-    let boxes: Vec<Aabb> = ids.iter().map(|&t| Aabb::of_points(&mesh.corners(t as usize))).collect();
+    let (ids, boxes) = candidates(mesh);
     let bvh = Bvh::build(&boxes);
     let mut pairs = Vec::new();
     bvh.overlapping_pairs_until(
