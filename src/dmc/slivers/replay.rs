@@ -61,6 +61,13 @@ fn same_triangle(a: [u32; 3], b: [u32; 3]) -> bool {
     (0..3).any(|r| a == [b[r], b[(r + 1) % 3], b[(r + 2) % 3]])
 }
 
+/// A triangle turned to start at its smallest vertex: equal for the same triangle the same way
+/// round.
+fn canonical(t: [u32; 3]) -> [u32; 3] {
+    let r = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+    [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
+}
+
 /// Cubes of side `cube` that the bounding box of a triangle with a vertex not clean touches.
 struct Unclean {
     cube: f64,
@@ -126,7 +133,7 @@ pub(super) fn replay(work: &mut Work, history: &History, cube: f64) -> usize {
         (!m.contains(&NONE)).then_some(m)
     };
 
-    // Clean at the start: the same fan, triangle for triangle.
+    // Clean at the start: the same fan, triangle for triangle (as multisets).
     let mut old_fans: Vec<Vec<u32>> = vec![Vec::new(); history.positions.len()];
     for (f, t) in history.triangles.iter().enumerate() {
         for &v in t {
@@ -134,17 +141,22 @@ pub(super) fn replay(work: &mut Work, history: &History, cube: f64) -> usize {
         }
     }
     let mut clean = vec![false; work.positions.len()];
+    let (mut was, mut is) = (Vec::new(), Vec::new());
     for (old, fan) in old_fans.iter().enumerate() {
         let new = to_new[old];
-        if new == NONE {
+        if new == NONE || work.faces_of[new as usize].len() != fan.len() {
             continue;
         }
-        let here = &work.faces_of[new as usize];
-        clean[new as usize] = here.len() == fan.len()
-            && fan.iter().all(|&f| {
-                map(history.triangles[f as usize])
-                    .is_some_and(|t| here.iter().any(|&g| same_triangle(work.triangles[g as usize], t)))
-            });
+        was.clear();
+        was.extend(fan.iter().map_while(|&f| map(history.triangles[f as usize]).map(canonical)));
+        if was.len() != fan.len() {
+            continue;
+        }
+        is.clear();
+        is.extend(work.faces_of[new as usize].iter().map(|&g| canonical(work.triangles[g as usize])));
+        was.sort_unstable();
+        is.sort_unstable();
+        clean[new as usize] = was == is;
     }
 
     let mut unclean = Unclean { cube, cubes: FxHashSet::default() };
