@@ -25,6 +25,18 @@ export async function settled(page, { allowErrors = false } = {}) {
   }
 }
 
+/**
+ * Opens `link` in a new page of `page`'s context and waits until it has meshed: the page's module
+ * awaits its wasm before it reads the link into the fields, so a field read as soon as `goto`
+ * returns can still be empty.
+ */
+export async function reopen(page, link) {
+  const again = await page.context().newPage();
+  await again.goto(link);
+  await settled(again);
+  return again;
+}
+
 export const stat = (page, side, key) => page.$eval(`${side} .stats tr[data-key="${key}"] td:last-child`, (td) => td.textContent);
 export const count = async (page, side, key) => Number((await stat(page, side, key)).replace(/,/g, ''));
 

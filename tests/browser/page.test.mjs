@@ -3,7 +3,7 @@
 // on change, a phone layout, bad triangles and the language reference. Headless Chromium.
 import { test, before, after, afterEach } from 'node:test';
 import assert from 'node:assert/strict';
-import { demoSuite, settled, stat, count, statsChanged, LEFT, RIGHT } from './demo-page.mjs';
+import { demoSuite, settled, stat, count, statsChanged, reopen, LEFT, RIGHT } from './demo-page.mjs';
 
 const { openDemo } = demoSuite({ before, after, afterEach });
 
@@ -191,8 +191,7 @@ test('"Smooth" relaxes both sides without moving a feature line or opening the m
   assert.equal(await count(page, LEFT, 'triangles'), triangles, 'smoothing moves vertices only');
   assert.notDeepEqual(await shape(), unsmoothed, 'the right pane\'s triangles changed shape');
   const link = page.url();
-  const again = await page.context().newPage();
-  await again.goto(link);
+  const again = await reopen(page, link);
   assert.equal(await again.inputValue('#smooth'), '3');
   await again.close();
 });
@@ -221,8 +220,7 @@ test('"within … cells" bounds the decimation: a tighter bound keeps more trian
   const tight = await decimated(0.25);
   const loose = await decimated(1);
   assert.ok(loose < tight, `${loose} triangles within 1 cell, ${tight} within 0.25`);
-  const again = await page.context().newPage();
-  await again.goto(page.url());
+  const again = await reopen(page, page.url());
   assert.equal(await again.inputValue('#decimate-error'), '1');
   await again.close();
 });
@@ -244,8 +242,7 @@ test('"Decimate to" shrinks both sides to the target, closed, with the frame\'s 
   assert.ok(before > 3 * 3000, `EMC had ${before} triangles before`);
   assert.ok(await count(page, LEFT, 'feature edges') > 0, 'EMC keeps its feature lines');
   const link = page.url();
-  const again = await page.context().newPage();
-  await again.goto(link);
+  const again = await reopen(page, link);
   assert.equal(await again.inputValue('#decimate'), '3000');
   await again.close();
 });
