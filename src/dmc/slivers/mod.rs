@@ -526,10 +526,14 @@ pub fn improve(
         candidates: Vec::new(),
         log: Vec::new(),
     };
-    let mut out = Improved { bad_before: work.bad_faces().len(), ..Improved::default() };
+    let mut bad = work.bad_faces();
+    let mut out = Improved { bad_before: bad.len(), ..Improved::default() };
     out.replayed = replay::replay(&mut work, history, near_cube(h));
-    for _ in 0..PASSES {
-        let bad = work.bad_faces();
+    for pass in 0..PASSES {
+        // The list taken before the replay serves the first pass if nothing was redone.
+        if pass > 0 || out.replayed > 0 {
+            bad = work.bad_faces();
+        }
         let mut changed = 0;
         for &(_, f) in &bad {
             if !work.alive[f as usize] || !work.shape(work.triangles[f as usize]).bad {

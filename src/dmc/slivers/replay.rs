@@ -56,11 +56,6 @@ fn ids_by_position(positions: &[Vec3]) -> FxHashMap<[u32; 3], u32> {
     ids
 }
 
-/// The same triangle, the same way round, whichever corner comes first.
-fn same_triangle(a: [u32; 3], b: [u32; 3]) -> bool {
-    (0..3).any(|r| a == [b[r], b[(r + 1) % 3], b[(r + 2) % 3]])
-}
-
 /// A triangle turned to start at its smallest vertex: equal for the same triangle the same way
 /// round.
 fn canonical(t: [u32; 3]) -> [u32; 3] {
@@ -211,7 +206,7 @@ fn translate(
         let here = map(before)?;
         let mut faces = work.faces_of[here[0] as usize]
             .iter()
-            .filter(|&&g| same_triangle(work.triangles[g as usize], here));
+            .filter(|&&g| canonical(work.triangles[g as usize]) == canonical(here));
         let (Some(&f), None) = (faces.next(), faces.next()) else { return None };
         let after = match after {
             // A triangle kept as it was stays as it is here (it may start at another corner).
