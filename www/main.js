@@ -17,15 +17,24 @@ const CHECKS = ['auto-bounds', 'live', 'wireframe', 'features', 'normals', 'bad'
 
 await init();
 
-let drawPending = false;
-/** Draws both views at the next frame, once however many changes asked. */
-const requestRender = () => {
-  if (drawPending) return;
-  drawPending = true;
-  requestAnimationFrame(() => {
-    drawPending = false;
-    for (const p of panes) p.render();
-  });
+/** The views to draw at the next frame (a set while one is asked for, else null). */
+let toDraw = null;
+/**
+ * Draws `pane`'s view at the next frame, or every view (the shared camera moved), once however
+ * many changes asked. A mesh arriving in one pane redraws that pane alone: in a browser drawing
+ * WebGL on the CPU (no GPU, as in headless Chromium) a frame of both 64-cell gears holds the
+ * main thread for over 100 ms, and with it the other pane's mesh arriving from its worker.
+ */
+const requestRender = (pane) => {
+  if (!toDraw) {
+    toDraw = new Set();
+    requestAnimationFrame(() => {
+      const drawing = toDraw;
+      toDraw = null;
+      for (const p of panes) if (drawing.has(p)) p.render();
+    });
+  }
+  for (const p of pane ? [pane] : panes) toDraw.add(p);
 };
 
 let scene = null;
@@ -277,7 +286,7 @@ document.addEventListener('keydown', (e) => {
   else if (e.key === 'Escape') stop();
   else if ((e.key === 'f' || e.key === 'F') && !e.ctrlKey && !e.metaKey && !(e.target instanceof HTMLInputElement || e.target instanceof HTMLTextAreaElement)) fitView();
 });
-matchMedia('(prefers-color-scheme: dark)').addEventListener('change', requestRender);
+matchMedia('(prefers-color-scheme: dark)').addEventListener('change', () => requestRender());
 
 showAngles();
 // A link wins over the last visit; a first visit gets the default scene.

@@ -22,12 +22,13 @@ export function tooLarge(message) {
 export class Pane {
   /**
    * `camera` and `target` are shared by all panes: orbiting one view moves the others.
-   * `onChange()` asks for a redraw; `onWayOut(res)` re-meshes at a resolution that fits.
+   * `onChange(pane)` asks for a redraw of `pane`, `onChange()` of every view; `onWayOut(res)`
+   * re-meshes at a resolution that fits.
    */
   constructor(root, { camera, target, method, color, onChange, onWayOut, fileName }) {
     this.root = root;
     this.camera = camera;
-    this.onChange = onChange;
+    this.onChange = () => onChange(this);
     this.fileName = fileName;
     this.methodSelect = root.querySelector('.method');
     this.methodSelect.value = method;
@@ -37,7 +38,7 @@ export class Pane {
     this.view.prepend(this.renderer.domElement);
     this.controls = new OrbitControls(camera, this.renderer.domElement);
     this.controls.target = target;
-    this.controls.addEventListener('change', onChange);
+    this.controls.addEventListener('change', () => onChange());
     this.scene = new THREE.Scene();
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.2));
     const sun = new THREE.DirectionalLight(0xffffff, 1.8);
@@ -52,7 +53,7 @@ export class Pane {
     this.wayOut.addEventListener('click', () => onWayOut(Number(this.wayOut.dataset.res)));
     root.querySelector('.download').addEventListener('click', () => this.download());
     root.querySelector('.cancel').addEventListener('click', () => this.cancel());
-    new ResizeObserver(() => { this.resize(); onChange(); }).observe(this.view);
+    new ResizeObserver(() => { this.resize(); this.onChange(); }).observe(this.view);
   }
 
   get method() {

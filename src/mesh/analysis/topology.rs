@@ -104,8 +104,8 @@ pub fn topology(mesh: &Mesh) -> Topology {
         degenerate_triangles: degenerate_triangles(mesh),
         ..Topology::default()
     };
-    count_edges(&faces, &mut topo, |v| component_of[v as usize] as usize, &mut component_euler);
-    topo.non_manifold_vertices = count_non_manifold_vertices(&faces, vertex_slots);
+    let component = |v: u32| component_of[v as usize] as usize;
+    count_edges_and_vertices(&faces, vertex_slots, &mut topo, component, &mut component_euler);
     topo.euler = topo.vertices as i64 - topo.edges as i64 + topo.faces as i64;
     if topo.is_closed_manifold() {
         topo.genus = Some(component_euler.iter().map(|chi| (2 - chi) / 2).sum());
@@ -138,74 +138,147 @@ fn is_collapsed(t: &[u32; 3]) -> bool {
     t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
 }
 
-/// Sorts all directed edges by their undirected key, then classifies each run of equal keys.
-fn count_edges(
+/// Incident faces per vertex, compressed rows: vertex `v`'s are `incident[start[v]..start[v + 1]]`.
+struct Fans {
+    start: Vec<u32>,
+    incident: Vec<u32>,
+}
+
+impl Fans {
+    fn new(faces: &[[u32; 3]], vertex_slots: usize) -> Fans {
+        let mut start = vec![0u32; vertex_slots + 1];
+        for &v in faces.iter().flatten() {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..vertex_slots {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut incident = vec![0u32; faces.len() * 3];
+        for (f, t) in faces.iter().enumerate() {
+            for &v in t {
+                incident[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Fans { start, incident }
+    }
+
+    fn of(&self, v: usize) -> &[u32] {
+        &self.incident[self.start[v] as usize..self.start[v + 1] as usize]
+    }
+}
+
+/// Fans up to this many triangles are checked in arrays on the stack (a closed mesh's vertices
+/// have six on average); larger ones in vectors.
+const SMALL_FAN: usize = 24;
+
+/// Counts and classifies the edges and applies the link rule of [`topology`] to every referenced
+/// vertex, in one pass over the vertices' fans: an edge is counted at its lower end, from the
+/// uses its fan's triangles make of it (a sort of all the directed edges and a vector per vertex
+/// were most of the time of the stats on a 24 000-triangle mesh).
+fn count_edges_and_vertices(
     faces: &[[u32; 3]],
+    vertex_slots: usize,
     topo: &mut Topology,
     component: impl Fn(u32) -> usize,
     component_euler: &mut [i64],
 ) {
-    // (min << 32 | max, whether this use goes from min to max)
-    let mut directed: Vec<(u64, bool)> = Vec::with_capacity(faces.len() * 3);
-    for t in faces {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let key = (a.min(b) as u64) << 32 | a.max(b) as u64;
-            directed.push((key, a < b));
+    let fans = Fans::new(faces, vertex_slots);
+    let mut link_buffer = Vec::new();
+    let mut uses_buffer = Vec::new();
+    let mut nodes = Vec::new();
+    for v in 0..vertex_slots {
+        let fan = fans.of(v);
+        if fan.is_empty() {
+            continue;
         }
-    }
-    directed.sort_unstable();
-    for run in directed.chunk_by(|x, y| x.0 == y.0) {
-        topo.edges += 1;
-        component_euler[component((run[0].0 >> 32) as u32)] -= 1;
-        let forward = run.iter().filter(|e| e.1).count();
-        match run.len() {
-            1 => topo.boundary_edges += 1,
-            2 if forward != 1 => topo.misoriented_edges += 1,
-            2 => {}
-            _ => topo.non_manifold_edges += 1,
+        let (mut small_link, mut small_uses) = ([(0u32, 0u32); SMALL_FAN], [(0u32, false); 2 * SMALL_FAN]);
+        let (link, uses): (&mut [(u32, u32)], &mut [(u32, bool)]) = if fan.len() <= SMALL_FAN {
+            (&mut small_link[..fan.len()], &mut small_uses[..2 * fan.len()])
+        } else {
+            link_buffer.resize(fan.len(), (0, 0));
+            uses_buffer.resize(2 * fan.len(), (0, false));
+            (&mut link_buffer[..], &mut uses_buffer[..])
+        };
+        // The link edge opposite `v` in each triangle, and the triangle's uses of the edges at
+        // `v`: from `v` to the next corner (forward, as the edge's key runs from its lower end,
+        // when that corner is above `v`) and from the previous corner to `v`.
+        let mut owned = 0;
+        for (i, &f) in fan.iter().enumerate() {
+            let t = faces[f as usize];
+            let k = t.iter().position(|&c| c as usize == v).unwrap_or(0);
+            let (next, prev) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+            link[i] = (next, prev);
+            if next as usize > v {
+                uses[owned] = (next, true);
+                owned += 1;
+            }
+            if prev as usize > v {
+                uses[owned] = (prev, false);
+                owned += 1;
+            }
+        }
+        let uses = &mut uses[..owned];
+        uses.sort_unstable_by_key(|u| u.0);
+        for run in uses.chunk_by(|x, y| x.0 == y.0) {
+            topo.edges += 1;
+            component_euler[component(v as u32)] -= 1;
+            let forward = run.iter().filter(|e| e.1).count();
+            match run.len() {
+                1 => topo.boundary_edges += 1,
+                2 if forward != 1 => topo.misoriented_edges += 1,
+                2 => {}
+                _ => topo.non_manifold_edges += 1,
+            }
+        }
+        let manifold = if fan.len() <= SMALL_FAN {
+            small_link_is_path_or_cycle(link)
+        } else {
+            link_is_path_or_cycle(link, &mut nodes)
+        };
+        if !manifold {
+            topo.non_manifold_vertices += 1;
         }
     }
 }
 
-/// Applies the link rule of [`topology`] to every referenced vertex.
-fn count_non_manifold_vertices(faces: &[[u32; 3]], vertex_slots: usize) -> usize {
-    // Incident faces per vertex, compressed-row.
-    let mut start = vec![0u32; vertex_slots + 1];
-    for &v in faces.iter().flatten() {
-        start[v as usize + 1] += 1;
-    }
-    for v in 0..vertex_slots {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut incident = vec![0u32; faces.len() * 3];
-    for (f, t) in faces.iter().enumerate() {
-        for &v in t {
-            incident[fill[v as usize] as usize] = f as u32;
-            fill[v as usize] += 1;
-        }
-    }
-
-    let mut link = Vec::new();
-    let mut nodes = Vec::new();
-    let mut count = 0;
-    for v in 0..vertex_slots {
-        let fan = &incident[start[v] as usize..start[v + 1] as usize];
-        if fan.is_empty() {
-            continue;
-        }
-        link.clear();
-        for &f in fan {
-            let t = faces[f as usize];
-            let k = t.iter().position(|&c| c as usize == v).unwrap_or(0);
-            link.push((t[(k + 1) % 3], t[(k + 2) % 3]));
-        }
-        if !link_is_path_or_cycle(&link, &mut nodes) {
+/// [`link_is_path_or_cycle`] for at most [`SMALL_FAN`] edges, on the stack: a path or a cycle
+/// has at most as many nodes as edges plus one, each node's degree is counted where it is
+/// found, and the components are joined in a union-find of the nodes' slots.
+fn small_link_is_path_or_cycle(link: &[(u32, u32)]) -> bool {
+    let mut nodes = [0u32; 2 * SMALL_FAN];
+    let mut degree = [0u8; 2 * SMALL_FAN];
+    let mut parent = [0u8; 2 * SMALL_FAN];
+    let mut count = 0usize;
+    let mut slot = |v: u32, nodes: &mut [u32], degree: &mut [u8], parent: &mut [u8]| -> usize {
+        let s = nodes[..count].iter().position(|&n| n == v).unwrap_or_else(|| {
+            nodes[count] = v;
+            parent[count] = count as u8;
             count += 1;
+            count - 1
+        });
+        degree[s] = degree[s].saturating_add(1);
+        s
+    };
+    let find = |parent: &mut [u8], mut x: usize| {
+        while parent[x] as usize != x {
+            parent[x] = parent[parent[x] as usize];
+            x = parent[x] as usize;
+        }
+        x
+    };
+    let mut merges = 0;
+    for &(a, b) in link {
+        let a = slot(a, &mut nodes, &mut degree, &mut parent);
+        let b = slot(b, &mut nodes, &mut degree, &mut parent);
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb)] = ra.min(rb) as u8;
+            merges += 1;
         }
     }
-    count
+    merges + 1 == count && degree[..count].iter().all(|&d| d <= 2)
 }
 
 /// True when the edges form one connected graph whose nodes all have degree at most two: a simple
@@ -385,6 +458,104 @@ mod tests {
         let t = topology(&m);
         assert_eq!(t.degenerate_triangles, 2);
         assert_eq!(t.faces, 9, "the collinear triangle is a 2-cell, the collapsed one is not");
+    }
+
+    /// The edge and vertex counts as first written (all directed edges sorted; each vertex's
+    /// link in vectors), kept as the reference the one-pass count must match.
+    fn reference_counts(faces: &[[u32; 3]], vertex_slots: usize) -> [usize; 5] {
+        let mut directed: Vec<(u64, bool)> = Vec::new();
+        for t in faces {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                directed.push(((a.min(b) as u64) << 32 | a.max(b) as u64, a < b));
+            }
+        }
+        directed.sort_unstable();
+        let [mut edges, mut boundary, mut misoriented, mut non_manifold] = [0; 4];
+        for run in directed.chunk_by(|x, y| x.0 == y.0) {
+            edges += 1;
+            let forward = run.iter().filter(|e| e.1).count();
+            match run.len() {
+                1 => boundary += 1,
+                2 if forward != 1 => misoriented += 1,
+                2 => {}
+                _ => non_manifold += 1,
+            }
+        }
+        let mut vertices = 0;
+        let mut nodes = Vec::new();
+        for v in 0..vertex_slots as u32 {
+            let link: Vec<(u32, u32)> = faces
+                .iter()
+                .filter_map(|t| t.iter().position(|&c| c == v).map(|k| (t[(k + 1) % 3], t[(k + 2) % 3])))
+                .collect();
+            if !link.is_empty() && !link_is_path_or_cycle(&link, &mut nodes) {
+                vertices += 1;
+            }
+        }
+        [edges, boundary, misoriented, non_manifold, vertices]
+    }
+
+    /// Random meshes of every defect: closed spheres and tori from MC with faces removed,
+    /// flipped, doubled and vertices welded, and soups of triangles over a few vertices (fins,
+    /// bow ties, fans of thirty triangles and more, past the stack arrays' size).
+    #[test]
+    fn one_pass_counts_match_the_reference_on_random_meshes() {
+        let mut rng = crate::expr::testutil::Rng::new(5);
+        let (sphere, _) = mc_sphere(10);
+        for case in 0..300 {
+            let mut triangles = if case % 2 == 0 {
+                let mut t = sphere.triangles.clone();
+                for _ in 0..rng.below(6) {
+                    let f = rng.below(t.len());
+                    match rng.below(4) {
+                        0 => {
+                            t.remove(f);
+                        }
+                        1 => t[f].swap(1, 2),
+                        2 => t.push(t[f]),
+                        _ => {
+                            let (a, b) = (t[f][0], t[rng.below(t.len())][1]);
+                            for tri in t.iter_mut() {
+                                for c in tri.iter_mut() {
+                                    if *c == b {
+                                        *c = a;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                t
+            } else {
+                let n = 3 + rng.below(12) as u32;
+                let hub = rng.below(2) == 0;
+                (0..1 + rng.below(60))
+                    .map(|_| {
+                        let mut c = || rng.below(n as usize) as u32;
+                        let t = [if hub { 0 } else { c() }, 0, 0];
+                        [t[0], c(), c()]
+                    })
+                    .map(|t| t.map(|v| v % n))
+                    .collect::<Vec<_>>()
+            };
+            triangles.retain(|t| !is_collapsed(t));
+            let slots = triangles.iter().flatten().map(|&v| v as usize + 1).max().unwrap_or(0);
+            let mesh = Mesh {
+                positions: vec![Vec3::ZERO; slots],
+                normals: Vec::new(),
+                triangles: triangles.clone(),
+            };
+            let t = topology(&mesh);
+            let got = [
+                t.edges,
+                t.boundary_edges,
+                t.misoriented_edges,
+                t.non_manifold_edges,
+                t.non_manifold_vertices,
+            ];
+            assert_eq!(got, reference_counts(&triangles, slots), "case {case}: {triangles:?}");
+        }
     }
 
     #[test]
