@@ -169,6 +169,12 @@ impl Fans {
     }
 }
 
+/// An edge of a vertex's link: the side of one of its triangles opposite it.
+type LinkEdge = (u32, u32);
+/// One triangle's use of an edge from a vertex: the edge's other end, and whether the use runs
+/// from the lower end to the upper.
+type EdgeUse = (u32, bool);
+
 /// Fans up to this many triangles are checked in arrays on the stack (a closed mesh's vertices
 /// have six on average); larger ones in vectors.
 const SMALL_FAN: usize = 24;
@@ -194,7 +200,7 @@ fn count_edges_and_vertices(
             continue;
         }
         let (mut small_link, mut small_uses) = ([(0u32, 0u32); SMALL_FAN], [(0u32, false); 2 * SMALL_FAN]);
-        let (link, uses): (&mut [(u32, u32)], &mut [(u32, bool)]) = if fan.len() <= SMALL_FAN {
+        let (link, uses): (&mut [LinkEdge], &mut [EdgeUse]) = if fan.len() <= SMALL_FAN {
             (&mut small_link[..fan.len()], &mut small_uses[..2 * fan.len()])
         } else {
             link_buffer.resize(fan.len(), (0, 0));
