@@ -312,6 +312,38 @@ impl Work<'_> {
         }
     }
 
+    /// Whether no new triangle of `change` turns from the true normal at its centre by more than
+    /// [`MAX_TURN_DEG`], or than the worst triangle it replaces, unless the change removes a
+    /// sliver. [`Work::better`] judges the turn at the corners, which a triangle with a corner on
+    /// each side of a crease passes; asked of every change, this rule left slivers at creases it
+    /// could not remove any more (the gyroid at 64 cells: smallest angle 1.5° -> 0.03°).
+    fn along_surface(&self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
+        let replaced = change.iter().filter(|&&(f, t)| t != Some(self.triangles[f as usize]));
+        let old: Vec<[u32; 3]> = replaced.clone().map(|&(f, _)| self.triangles[f as usize]).collect();
+        if old.iter().any(|&t| min_angle(&self.corners(t)) < SLIVER_DEG) {
+            return true;
+        }
+        let new: Vec<[u32; 3]> = replaced.filter_map(|&(_, t)| t).collect();
+        let after = self.centre_deviation(&new);
+        after <= MAX_TURN_DEG || after <= self.centre_deviation(&old)
+    }
+
+    /// The largest angle, in degrees, between one of `tris`' normals and the true normal at its
+    /// centre (180 for a triangle without a normal; 0 where the field has no gradient).
+    fn centre_deviation(&self, tris: &[[u32; 3]]) -> f64 {
+        tris.iter()
+            .map(|&t| {
+                let c = self.corners(t);
+                let n = normal(&c);
+                let Some(g) = self.field.gradient(((c[0] + c[1] + c[2]) / 3.0).as_vec3()) else { return 0.0 };
+                if n == glam::DVec3::ZERO {
+                    return 180.0;
+                }
+                n.dot(g.as_dvec3().normalize_or_zero()).clamp(-1.0, 1.0).acos().to_degrees()
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Whether the new triangles of `change` lie no farther from the surface than the tolerance,
     /// or than the triangles they replace (measured only when a new one is beyond the tolerance).
     fn near_surface(&mut self, change: &[(u32, Option<[u32; 3]>)]) -> bool {
@@ -462,7 +494,8 @@ fn near_cube(h: f32) -> f64 {
 /// condition (so the surface keeps its topology and stays a closed manifold), flips only to an edge
 /// not already there; the new triangles must leave fewer bad ones than the old (or as many with a
 /// larger worst angle), lie along the surface (within [`MAX_TURN_DEG`] of the true normal at a
-/// corner, or no worse than the worst triangle they replace), stay within the tolerance of the
+/// corner, or no worse than the worst triangle they replace; at their centres too where no
+/// sliver goes: `Work::along_surface`), stay within the tolerance of the
 /// surface (or no farther than the old ones), and neither cross nor fold onto any triangle nearby
 /// (the analysis's exact tests, on the triangles in [`crate::mesh::buckets`] of two finest cells,
 /// about a triangle's size).
@@ -558,9 +591,9 @@ pub fn improve(
             // asked only as far down the list as needed): fewest bad triangles, then the largest
             // worst angle.
             options.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(y.0 .1.total_cmp(&x.0 .1)));
-            if let Some((_, change, flip)) =
-                options.into_iter().find(|(_, change, _)| work.clear(change) && work.near_surface(change))
-            {
+            if let Some((_, change, flip)) = options.into_iter().find(|(_, change, _)| {
+                work.along_surface(change) && work.clear(change) && work.near_surface(change)
+            }) {
                 work.apply(&change, flip);
                 changed += 1;
             }
