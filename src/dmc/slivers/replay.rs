@@ -204,9 +204,10 @@ fn translate(
     };
     for &(before, after) in logged {
         let here = map(before)?;
+        let wanted = canonical(here);
         let mut faces = work.faces_of[here[0] as usize]
             .iter()
-            .filter(|&&g| canonical(work.triangles[g as usize]) == canonical(here));
+            .filter(|&&g| canonical(work.triangles[g as usize]) == wanted);
         let (Some(&f), None) = (faces.next(), faces.next()) else { return None };
         let after = match after {
             // A triangle kept as it was stays as it is here (it may start at another corner).
