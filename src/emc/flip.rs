@@ -117,7 +117,7 @@ pub fn flip_toward_features(
         }
         let (tri1, tri2) = ([c, a, d], [d, b, c]);
         let buckets = nearby.get_or_insert_with(|| NearbyTriangles::around(mesh, spacing, &region));
-        if [tri1, tri2].iter().any(|&t| buckets.crosses(mesh, t, &t.map(p), &[t1, t2])) {
+        if buckets.any_crosses(mesh, &[(tri1, tri1.map(p)), (tri2, tri2.map(p))], &[t1, t2]) {
             continue;
         }
         mesh.triangles[t1 as usize] = tri1;

@@ -201,7 +201,7 @@ fn weld_crosses(
     skip: &[u32],
 ) -> bool {
     let d64 = |c: &[Vec3; 3]| c.map(|p| p.as_dvec3());
-    welded.iter().any(|(tri, corners)| nearby.crosses(mesh, *tri, corners, skip))
+    nearby.any_crosses(mesh, welded, skip)
         || welded.iter().enumerate().any(|(i, (a, ca))| {
             welded[i + 1..].iter().any(|(b, cb)| indexed_pair_intersects((*a, d64(ca)), (*b, d64(cb))))
         })

@@ -104,12 +104,50 @@ impl NearbyTriangles {
     /// than those in `skip`, by the self-intersection checker's rules (sharing an edge never
     /// counts, sharing a vertex counts when they overlap beyond it).
     pub fn crosses(&mut self, mesh: &Mesh, ids: [u32; 3], corners: &[Vec3; 3], skip: &[u32]) -> bool {
-        let new: ([u32; 3], [DVec3; 3]) = (ids, corners64(corners));
-        self.near(corners).into_iter().filter(|t| !skip.contains(t)).any(|t| {
+        self.any_crosses(mesh, &[(ids, *corners)], skip)
+    }
+
+    /// [`NearbyTriangles::crosses`] for several triangles side by side (a flip's two, a fan), with
+    /// one look-up over the box of them all: the triangles a change makes share most of their
+    /// neighbourhood, and the look-up, not the crossing tests, is most of a question's cost
+    /// (the gear's flips at 64 cells: 1.4 µs a look-up, 50 ns a test).
+    pub fn any_crosses(&mut self, mesh: &Mesh, new: &[([u32; 3], [Vec3; 3])], skip: &[u32]) -> bool {
+        let Some(((lo, hi), new)) = union_bounds(new) else { return false };
+        // Each triangle's box must lie in the region (the box of them all need not): a triangle
+        // that crosses one of them meets its box, so it was recorded.
+        debug_assert!(
+            new.iter().all(|(_, _, (lo, hi))| self.region.as_ref().is_none_or(|r| r.covers(*lo, *hi))),
+            "asked outside the region"
+        );
+        let mut near = Vec::new();
+        self.buckets.query(lo, hi, &mut near);
+        near.into_iter().filter(|t| !skip.contains(t)).any(|t| {
             let t = t as usize;
-            indexed_pair_intersects(new, (mesh.triangles[t], corners64(&mesh.corners(t))))
+            let (ids, corners) = (mesh.triangles[t], corners64(&mesh.corners(t)));
+            let (tlo, thi) = bounds(&corners);
+            new.iter().any(|&(ids_new, corners_new, (nlo, nhi))| {
+                nlo.cmple(thi).all()
+                    && nhi.cmpge(tlo).all()
+                    && indexed_pair_intersects((ids_new, corners_new), (ids, corners))
+            })
         })
     }
+}
+
+/// The triangles' corners in `f64` with each one's box, and the box of them all (`None`: none).
+#[allow(clippy::type_complexity)]
+fn union_bounds(
+    new: &[([u32; 3], [Vec3; 3])],
+) -> Option<((DVec3, DVec3), Vec<([u32; 3], [DVec3; 3], (DVec3, DVec3))>)> {
+    let boxed: Vec<_> = new
+        .iter()
+        .map(|(ids, corners)| {
+            let c = corners64(corners);
+            (*ids, c, bounds(&c))
+        })
+        .collect();
+    let all = boxed.iter().map(|b| b.2).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
+    Some((all, boxed))
 }
 
 /// The cubes of side `cell` that some boxes reach into (each grown by a hundredth of a cube, more

@@ -64,10 +64,10 @@ pub fn pull_back_crossing_fans(
     let mut moved = Vec::new();
     fans.retain(|fan| {
         let own = &incident[&fan.vertex];
-        let cuts = own.iter().any(|&s| {
-            let s_ = s as usize;
-            buckets.crosses(mesh, mesh.triangles[s_], &mesh.corners(s_), &[s])
-        });
+        let triangles: Vec<([u32; 3], [Vec3; 3])> =
+            own.iter().map(|&s| (mesh.triangles[s as usize], mesh.corners(s as usize))).collect();
+        // A fan triangle tested against itself shares its three corners, which never counts.
+        let cuts = buckets.any_crosses(mesh, &triangles, &[]);
         if cuts {
             mesh.positions[fan.vertex as usize] = fan.inside.position;
             for &s in own {
