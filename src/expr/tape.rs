@@ -45,7 +45,7 @@ impl Tape {
         last_use[root as usize] = usize::MAX;
 
         let mut slot = vec![0 as Slot; n];
-        let mut consts = Vec::new();
+        let mut consts = Vec::with_capacity(n);
         for (i, node) in nodes.iter().enumerate() {
             if let Node::Const(bits) = node {
                 slot[i] = consts.len() as Slot;
@@ -61,8 +61,10 @@ impl Tape {
                 next += 1;
             }
         }
-        let mut free: Vec<Slot> = Vec::new();
-        let mut instrs = Vec::new();
+        // Sized up front: a brick's tape is built from its parent's nodes (hundreds on a CSG part),
+        // and growing these vectors step by step was a quarter of the building's instructions.
+        let mut free: Vec<Slot> = Vec::with_capacity(n);
+        let mut instrs = Vec::with_capacity(n);
         // Inputs nobody reads (impossible after compaction, but harmless) are simply never freed.
         for (i, node) in nodes.iter().enumerate() {
             let instr = match *node {
