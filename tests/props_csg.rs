@@ -301,14 +301,36 @@ fn prop_emc_does_not_cross_itself() {
 }
 
 /// DMC with the topology of MC on its finest grid, where that grid resolves the tree (see
-/// [`resolved_fine_mc`]).
+/// [`resolved_fine_mc`]; where DMC disagrees, MC at eight times the resolution is asked too,
+/// see [`unresolved_at_eight_times`]).
 #[test]
 fn prop_dmc_keeps_fine_mcs_topology() {
     for_trees(8_500_000, |case| {
         if let Some((fine, finest)) = resolved_fine_mc(case) {
-            assert_dmc_has_the_topology_of(case, &fine, finest);
+            let dmc = dmc_topology(case);
+            if dmc != topology(&fine) && unresolved_at_eight_times(case, &fine, finest) {
+                return;
+            }
+            assert_eq!(dmc, topology(&fine), "dmc vs mc at {finest} cells\n{}", case.describe());
         }
     });
+}
+
+fn topology(out: &Output) -> (i64, usize) {
+    (out.stats.euler, out.stats.components)
+}
+
+fn dmc_topology(case: &Case) -> (i64, usize) {
+    topology(&case.mesh(Method::Dmc, Topology::Fixed))
+}
+
+/// Whether MC at eight times the finest resolution sees another topology than `fine`: a feature
+/// under a quarter of a finest cell that the grids at one, two and four times step over alike
+/// (seed 8500303: a torus whose hole is a sixth of a cell wide). Asked only where DMC and `fine`
+/// disagree, which is the only place it can change a verdict: a tree it shows unresolved is
+/// skipped, and one where DMC agrees passes either way. At 256 cells and more it costs seconds.
+fn unresolved_at_eight_times(case: &Case, fine: &Output, finest: usize) -> bool {
+    topology(&case.at(8 * finest).mesh(Method::Mc, Topology::Fixed)) != topology(fine)
 }
 
 /// MC on the grid of DMC's finest level for `case`, and that grid's resolution, where the grid
@@ -323,7 +345,6 @@ fn resolved_fine_mc(case: &Case) -> Option<(Output, usize)> {
     let fine = case.at(finest).mesh(Method::Mc, Topology::Fixed);
     let shift = Vec3::splat(2.0 / finest as f32 / 3.0);
     let moved = case.at(finest).mesh_in(Method::Mc, (Vec3::splat(-1.0) + shift, Vec3::splat(1.0) + shift));
-    let topology = |mc: &Output| (mc.stats.euler, mc.stats.components);
     let resolved = mc_closed(&fine)
         && mc_closed(&moved)
         && topology(&fine) == topology(&moved)
@@ -433,6 +454,21 @@ fn a_sliver_both_grids_step_over_is_not_resolved() {
     let case = Case::new(8_503_064);
     assert_eq!(case.res.next_power_of_two(), 32, "the case: {}", case.describe());
     assert!(resolved_fine_mc(&case).is_none(), "{}", case.describe());
+}
+
+/// A torus whose hole is 0.01 wide (major radius 0.116, tube 0.111), a sixth of a cell at 32 cells:
+/// MC at 32, 64 and 128 cells and on the moved grid all step over the hole (genus 0), MC at 256
+/// sees it, and DMC at 32 finest cells has it too (its crust is found by interval bounds). Found by
+/// a soak of 400 trees; the property asks MC at eight times the resolution where DMC disagrees.
+#[test]
+fn a_torus_hole_a_sixth_of_a_cell_wide_is_resolved_only_at_eight_times_on_seed_8500303() {
+    let case = Case::new(8_500_303);
+    assert!(case.tree.text.contains("torus(0.116, 0.111)"), "the case: {}", case.describe());
+    let (fine, finest) = resolved_fine_mc(&case).expect("the grids up to four times agree");
+    assert_eq!(finest, 32, "the case: {}", case.describe());
+    assert!(unresolved_at_eight_times(&case, &fine, finest), "{}", case.describe());
+    let eight = case.at(8 * finest).mesh(Method::Mc, Topology::Fixed);
+    assert_eq!(dmc_topology(&case), topology(&eight), "{}", case.describe());
 }
 
 /// An offset box at 32 cells whose rounded edge (half a cell in radius) runs along a grid line:
