@@ -92,25 +92,32 @@ impl NearbyTriangles {
     }
 
     /// Every recorded triangle whose box overlaps the box of `corners`, each once.
-    pub fn near(&mut self, corners: &[Vec3; 3]) -> Vec<u32> {
+    #[cfg(test)]
+    fn near(&mut self, corners: &[Vec3; 3]) -> Vec<u32> {
         let (lo, hi) = bounds(&corners64(corners));
         debug_assert!(self.region.as_ref().is_none_or(|r| r.covers(lo, hi)), "asked outside the region");
+        self.overlapping(lo, hi)
+    }
+
+    /// Every recorded triangle whose box overlaps `lo..hi`, each once.
+    fn overlapping(&mut self, lo: DVec3, hi: DVec3) -> Vec<u32> {
         let mut out = Vec::new();
         self.buckets.query(lo, hi, &mut out);
         out
     }
 
-    /// Whether the triangle `ids` at `corners` crosses any recorded triangle of `mesh` nearby other
-    /// than those in `skip`, by the self-intersection checker's rules (sharing an edge never
-    /// counts, sharing a vertex counts when they overlap beyond it).
-    pub fn crosses(&mut self, mesh: &Mesh, ids: [u32; 3], corners: &[Vec3; 3], skip: &[u32]) -> bool {
+    /// [`NearbyTriangles::any_crosses`] for one triangle.
+    #[cfg(test)]
+    fn crosses(&mut self, mesh: &Mesh, ids: [u32; 3], corners: &[Vec3; 3], skip: &[u32]) -> bool {
         self.any_crosses(mesh, &[(ids, *corners)], skip)
     }
 
-    /// [`NearbyTriangles::crosses`] for several triangles side by side (a flip's two, a fan), with
-    /// one look-up over the box of them all: the triangles a change makes share most of their
-    /// neighbourhood, and the look-up, not the crossing tests, is most of a question's cost
-    /// (the gear's flips at 64 cells: 1.4 µs a look-up, 50 ns a test).
+    /// Whether any of the triangles `new` (ids and corners, side by side: a flip's two, a fan)
+    /// crosses a recorded triangle of `mesh` nearby other than those in `skip`, by the
+    /// self-intersection checker's rules (sharing an edge never counts, sharing a vertex counts
+    /// when they overlap beyond it). One look-up over the box of them all: the triangles a change
+    /// makes share most of their neighbourhood, and the look-up, not the crossing tests, is most
+    /// of a question's cost (the gear's flips at 64 cells: 1.4 µs a look-up, 50 ns a test).
     pub fn any_crosses(&mut self, mesh: &Mesh, new: &[([u32; 3], [Vec3; 3])], skip: &[u32]) -> bool {
         let Some(((lo, hi), new)) = union_bounds(new) else { return false };
         // Each triangle's box must lie in the region (the box of them all need not): a triangle
@@ -119,9 +126,7 @@ impl NearbyTriangles {
             new.iter().all(|(_, _, (lo, hi))| self.region.as_ref().is_none_or(|r| r.covers(*lo, *hi))),
             "asked outside the region"
         );
-        let mut near = Vec::new();
-        self.buckets.query(lo, hi, &mut near);
-        near.into_iter().filter(|t| !skip.contains(t)).any(|t| {
+        self.overlapping(lo, hi).into_iter().filter(|t| !skip.contains(t)).any(|t| {
             let t = t as usize;
             let (ids, corners) = (mesh.triangles[t], corners64(&mesh.corners(t)));
             let (tlo, thi) = bounds(&corners);
