@@ -26,8 +26,16 @@ use crate::mesh::analysis::topology::UnionFind;
 use crate::tables::{triangle_table_with_faces_without_centre, EDGES};
 use rustc_hash::FxHashMap as HashMap;
 
-/// A triangle of the contour named by its three dual edges (inside end, outside end).
-pub type EdgeTriangle = [(VertexKey, VertexKey); 3];
+/// A dual edge by its ends (inside end, outside end): the name of the crossing on it.
+pub type DualEdge = (VertexKey, VertexKey);
+
+/// The contour a merge would leave in its star: the dual edges its triangles' corners lie on,
+/// each once, and the triangles as indices into them.
+#[derive(Debug, Clone, Default)]
+pub struct Star {
+    pub edges: Vec<DualEdge>,
+    pub triangles: Vec<[u32; 3]>,
+}
 
 /// Buffers one thread's safety tests reuse from merge to merge: a test allocates nothing of its
 /// own, and allocation was a fifth of its time (a merge tests a few dozen dual cells).
@@ -45,10 +53,12 @@ pub struct Scratch {
     tris_after: Vec<[u32; 3]>,
     boundary_before: Vec<(u32, u32)>,
     discs: Discs,
+    /// Per crossing, its index in the star returned (`u32::MAX`: none yet).
+    used: Vec<u32>,
 }
 
 /// Whether making internal node `n` (whose children are all leaves) a leaf whose vertex has value
-/// `value` keeps the contour's topology; if it does, the triangles the star would then hold.
+/// `value` keeps the contour's topology; if it does, the contour the star would then hold.
 pub fn merge_is_safe(
     tree: &Octree,
     n: u32,
@@ -56,7 +66,7 @@ pub fn merge_is_safe(
     field: &dyn Field,
     iso: f32,
     scratch: &mut Scratch,
-) -> Option<Vec<EdgeTriangle>> {
+) -> Option<Star> {
     let Scratch {
         around,
         stack,
@@ -70,6 +80,7 @@ pub fn merge_is_safe(
         tris_after,
         boundary_before,
         discs,
+        used,
     } = scratch;
     around.fill(tree, n, stack);
     // The star's points before the merge: the children's corners and the neighbours' corners on
@@ -100,26 +111,34 @@ pub fn merge_is_safe(
     let joined = |cell: &[VertexKey; 8], case: u8| {
         super::faces::joined_faces(case, |k| dual::centre(tree, cell[k]), field, iso)
     };
-    crossings.ids.clear();
+    crossings.clear();
     star_triangles(cells_before, sign_before, joined, crossings, tris_before);
     star_triangles(cells_after, sign_after, joined, crossings, tris_after);
-    let edges = |tris: &[[u32; 3]]| -> Vec<EdgeTriangle> {
-        let mut by_id =
-            vec![(VertexKey { node: NONE, clamp: 0 }, VertexKey { node: NONE, clamp: 0 }); crossings.len()];
-        for (&e, &id) in &crossings.ids {
-            by_id[id as usize] = e;
-        }
-        tris.iter().map(|t| t.map(|v| by_id[v as usize])).collect()
-    };
     if tris_before.is_empty() && tris_after.is_empty() {
-        return Some(Vec::new());
+        return Some(Star::default());
     }
     boundary_before.clear();
     boundary_before.extend_from_slice(discs.boundary(tris_before, crossings.len())?);
     match discs.boundary(tris_after, crossings.len()) {
-        Some(after) if after == &boundary_before[..] => Some(edges(tris_after)),
+        Some(after) if after == &boundary_before[..] => Some(star(tris_after, crossings, used)),
         _ => None,
     }
+}
+
+/// The star of `tris` (crossing ids): the crossings they use, in the order of first use.
+fn star(tris: &[[u32; 3]], crossings: &Crossings, used: &mut Vec<u32>) -> Star {
+    reset(used, crossings.len(), u32::MAX);
+    let mut star = Star { edges: Vec::new(), triangles: Vec::with_capacity(tris.len()) };
+    for t in tris {
+        star.triangles.push(t.map(|v| {
+            if used[v as usize] == u32::MAX {
+                used[v as usize] = star.edges.len() as u32;
+                star.edges.push(crossings.edges[v as usize]);
+            }
+            used[v as usize]
+        }));
+    }
+    star
 }
 
 /// The star's points of a merge of node `n`, each once, in the order of their keys (z, then y,
@@ -280,17 +299,28 @@ impl Neighbourhood {
 /// the contours before and after a merge share the names of the crossings they share.
 #[derive(Default)]
 struct Crossings {
-    ids: HashMap<(VertexKey, VertexKey), u32>,
+    ids: HashMap<DualEdge, u32>,
+    /// Per id, its dual edge.
+    edges: Vec<DualEdge>,
 }
 
 impl Crossings {
-    fn id(&mut self, edge: (VertexKey, VertexKey)) -> u32 {
-        let next = self.ids.len() as u32;
-        *self.ids.entry(edge).or_insert(next)
+    fn id(&mut self, edge: DualEdge) -> u32 {
+        let next = self.edges.len() as u32;
+        let id = *self.ids.entry(edge).or_insert(next);
+        if id == next {
+            self.edges.push(edge);
+        }
+        id
     }
 
     fn len(&self) -> usize {
-        self.ids.len()
+        self.edges.len()
+    }
+
+    fn clear(&mut self) {
+        self.ids.clear();
+        self.edges.clear();
     }
 }
 
