@@ -81,27 +81,7 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
     let leaves = tree.leaves();
     let crust: Vec<u32> =
         leaves.iter().copied().filter(|&n| tree.nodes[n as usize].kind == Kind::Surface).collect();
-    let mut index: HashMap<u64, u32> =
-        HashMap::with_capacity_and_hasher(crust.len() * (k as usize).pow(3) + 16, Default::default());
-    let mut points = Vec::new();
-    let mut cell_samples = Vec::with_capacity(crust.len() * (samples_per_cell).pow(3));
-    for &n in &crust {
-        let c = tree.nodes[n as usize].coord;
-        for dz in 0..=k {
-            for dy in 0..=k {
-                for dx in 0..=k {
-                    let l = [c[0] * k + dx, c[1] * k + dy, c[2] * k + dz];
-                    let key = super::dual::point_key(l);
-                    let id = *index.entry(key).or_insert_with(|| {
-                        points
-                            .push(tree.lattice(Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) / k as f32));
-                        points.len() as u32 - 1
-                    });
-                    cell_samples.push(id);
-                }
-            }
-        }
-    }
+    let (points, cell_samples) = lattice(tree, &crust, k);
     stats.samples = points.len();
     let (values, gradients) =
         crate::field::values_and_gradients_or_differences(field, &points, spacing * 1e-2);
@@ -149,6 +129,66 @@ pub fn sample(tree: &mut Octree, field: &Clipped, iso: f32, samples_per_cell: us
         }
     }
     settle_isolated(tree, field, iso, &crust, &centres);
+}
+
+/// The crust's sample lattice: each point once, and per crust cell (in `crust`'s order) its
+/// `(k + 1)³` points' indices, x fastest.
+///
+/// A lattice point is shared by the up to eight crust cells around it, so points are named in a
+/// map; the cells go layer by layer along z with one map per lattice plane of the layer, and a
+/// layer's top plane is the next layer's bottom one. Each map then holds one plane's points of the
+/// crust, small enough to stay in cache: one map of every point (2.4 million for a sphere at 256
+/// cells) took 270 ms, probing memory at random.
+fn lattice(tree: &Octree, crust: &[u32], k: u32) -> (Vec<Vec3>, Vec<u32>) {
+    let per_cell = ((k + 1) as usize).pow(3);
+    let coord = |i: u32| tree.nodes[crust[i as usize] as usize].coord;
+    // The cells by layer (a counting sort on z, keeping the crust's order within a layer).
+    let layers = tree.cells[2] as usize;
+    let mut start = vec![0u32; layers + 1];
+    for i in 0..crust.len() as u32 {
+        start[coord(i)[2] as usize + 1] += 1;
+    }
+    for z in 0..layers {
+        start[z + 1] += start[z];
+    }
+    let mut by_layer = vec![0u32; crust.len()];
+    let mut fill = start.clone();
+    for i in 0..crust.len() as u32 {
+        let z = coord(i)[2] as usize;
+        by_layer[fill[z] as usize] = i;
+        fill[z] += 1;
+    }
+    let mut planes: Vec<HashMap<u64, u32>> = vec![HashMap::default(); k as usize + 1];
+    let mut points = Vec::new();
+    let mut cell_samples = vec![0u32; crust.len() * per_cell];
+    for z in 0..layers {
+        let cells = &by_layer[start[z] as usize..start[z + 1] as usize];
+        for &i in cells {
+            let c = coord(i);
+            let mut slot = i as usize * per_cell;
+            for dz in 0..=k {
+                for dy in 0..=k {
+                    for dx in 0..=k {
+                        let l = [c[0] * k + dx, c[1] * k + dy, c[2] * k + dz];
+                        let key = (l[1] as u64) << 32 | l[0] as u64;
+                        cell_samples[slot] = *planes[dz as usize].entry(key).or_insert_with(|| {
+                            points.push(
+                                tree.lattice(Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32) / k as f32),
+                            );
+                            points.len() as u32 - 1
+                        });
+                        slot += 1;
+                    }
+                }
+            }
+        }
+        // The top plane is the next layer's bottom one; the others are done with.
+        planes.swap(0, k as usize);
+        for plane in &mut planes[1..] {
+            plane.clear();
+        }
+    }
+    (points, cell_samples)
 }
 
 /// Whether the dual vertex of the leaf holding finest cell `q` (offset by `d`) is inside; beyond
