@@ -66,6 +66,25 @@ fn scene_stats_have_every_key() {
     assert_eq!(s["genus"], 1);
 }
 
+/// A reader that stops before the output comes (`isoforge ... --stats | true`) is no panic: the
+/// output is dropped quietly, exit status 0 (`println!` panicked with a backtrace).
+#[test]
+fn a_reader_closing_stdout_early_is_not_a_panic() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_isoforge"))
+        .args(["mesh", "--scene", "gear", "--res", "32", "--stats"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run isoforge");
+    // Closed long before the mesh and its stats are done.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(out.status.success(), "{stderr}");
+}
+
 #[test]
 fn scenes_are_listed_and_their_programs_printed() {
     let names = ok(&["scenes"]);

@@ -191,12 +191,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Scenes { name: None } => {
-            for name in scenes::SCENE_NAMES {
-                println!("{name}");
-            }
-            Ok(())
+            print_out(&scenes::SCENE_NAMES.map(|name| format!("{name}\n")).concat())
         }
-        Command::Scenes { name: Some(name) } => scenes::source(&name).map(|text| print!("{text}")),
+        Command::Scenes { name: Some(name) } => scenes::source(&name).and_then(print_out),
         Command::Mesh(args) => mesh(*args),
     };
     match result {
@@ -205,6 +202,20 @@ fn main() -> ExitCode {
             eprintln!("isoforge: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Writes `text` to stdout. A reader that has stopped reading (`isoforge ... --stats | head -c
+/// 100`) is not an error, as for any Unix filter: the rest is dropped quietly (`println!` panicked
+/// there, with a backtrace).
+fn print_out(text: &str) -> Result<(), Error> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::Io(format!("writing to stdout: {e}")))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -262,7 +273,7 @@ fn mesh(args: MeshArgs) -> Result<(), Error> {
         }
     }
     if args.stats {
-        println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Io(e.to_string()))?);
+        print_out(&(serde_json::to_string(&out.stats).map_err(|e| Error::Io(e.to_string()))? + "\n"))?;
     }
     Ok(())
 }
