@@ -52,7 +52,7 @@ impl<'a> Fidelity<'a> {
         // edge two of them have is rare, and found twice), and per star its triangles' distinct
         // midpoints, named by sorting its few edge pairs.
         let mut edges: Vec<DualEdge> = Vec::new();
-        let mut midpoints: Vec<u64> = Vec::new();
+        let mut midpoints: Vec<(u32, u32)> = Vec::new();
         // Per triangle, its three corners' and then its three midpoints' indices.
         let mut triangles: Vec<[u32; 6]> = Vec::with_capacity(stars.iter().map(|s| s.triangles.len()).sum());
         let mut pairs = Vec::new();
@@ -64,7 +64,7 @@ impl<'a> Fidelity<'a> {
                 star.triangles.iter().flat_map(|t| {
                     [(0, 1), (1, 2), (2, 0)].map(|(i, j)| {
                         let (a, b) = (first_edge + t[i], first_edge + t[j]);
-                        (a.min(b) as u64) << 32 | a.max(b) as u64
+                        (a.min(b), a.max(b))
                     })
                 }),
                 &mut pairs,
@@ -85,9 +85,7 @@ impl<'a> Fidelity<'a> {
             .iter()
             .map(|t| (crossings[t[0] as usize] + crossings[t[1] as usize] + crossings[t[2] as usize]) / 3.0)
             .collect();
-        points.extend(
-            midpoints.iter().map(|&m| (crossings[(m >> 32) as usize] + crossings[m as u32 as usize]) * 0.5),
-        );
+        points.extend(midpoints.iter().map(|&(a, b)| (crossings[a as usize] + crossings[b as usize]) * 0.5));
         let (values, gradients) = values_and_gradients_or_differences(self.field, &points, tree.h * 1e-2);
         let close: Vec<bool> = values
             .iter()
