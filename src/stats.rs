@@ -61,6 +61,11 @@ pub struct Stats {
     /// [`analysis::SurfaceError::crease_faces`]): where "crinkly" edges show.
     pub crease_faces: Option<usize>,
     pub crease_normal_dev_deg_p95: Option<f64>,
+    /// Per face against the nearest true normal near it (see
+    /// [`analysis::SurfaceError::face_normal_dev_deg_max`]): crease faces lying flat count as
+    /// right, spikes and faces turned over do not.
+    pub face_normal_dev_deg_p95: Option<f64>,
+    pub face_normal_dev_deg_max: Option<f64>,
     /// Wall-clock time of the meshing itself (all phases, analysis excluded).
     pub ms_total: f64,
     /// Time per phase of the method, in the order they ran (a JSON object, insertion ordered).
@@ -189,6 +194,8 @@ pub fn compute(
         normal_dev_deg_max: error.as_ref().map(|e| e.normal_dev_deg_max),
         crease_faces: error.as_ref().map(|e| e.crease_faces),
         crease_normal_dev_deg_p95: error.as_ref().map(|e| e.crease_normal_dev_deg_p95),
+        face_normal_dev_deg_p95: error.as_ref().map(|e| e.face_normal_dev_deg_p95),
+        face_normal_dev_deg_max: error.as_ref().map(|e| e.face_normal_dev_deg_max),
         ms_total,
         phases_ms,
         ms_analysis: crate::mc::ms_since(t0),

@@ -12,6 +12,7 @@ const ROWS = [
   ['max distance', 'dist_max'], ['RMS distance', 'dist_rms'],
   ['normal deviation p95 (°)', 'normal_dev_deg_p95'],
   ['  at sharp edges (°)', 'crease_normal_dev_deg_p95'],
+  ['worst face (°)', 'face_normal_dev_deg_max'],
   ['crossing pairs', 'self_intersections'],
   ['smallest angle (°)', 'min_angle_deg'], ['largest angle (°)', 'max_angle_deg'],
   ['feature edges', 'feature_edges'],

@@ -34,6 +34,7 @@ export interface MeshAnalysis {
   dist_max: number | null; dist_rms: number | null;
   normal_dev_deg_p50: number | null; normal_dev_deg_p95: number | null; normal_dev_deg_max: number | null;
   crease_faces: number | null; crease_normal_dev_deg_p95: number | null;
+  face_normal_dev_deg_p95: number | null; face_normal_dev_deg_max: number | null;
   self_intersections: number | null;
   /** The crossing pairs as triangle indices, two per pair (empty where not asked for). */
   self_intersecting_pairs: Uint32Array;
@@ -97,6 +98,8 @@ pub fn analyze_mesh(
     set("normal_dev_deg_max", number(|e| e.normal_dev_deg_max))?;
     set("crease_faces", number(|e| e.crease_faces as f64))?;
     set("crease_normal_dev_deg_p95", number(|e| e.crease_normal_dev_deg_p95))?;
+    set("face_normal_dev_deg_p95", number(|e| e.face_normal_dev_deg_p95))?;
+    set("face_normal_dev_deg_max", number(|e| e.face_normal_dev_deg_max))?;
     set("self_intersections", pairs.as_ref().map_or(JsValue::NULL, |p| (p.len() as f64).into()))?;
     let flat: Vec<u32> = pairs.iter().flatten().flatten().copied().collect();
     set("self_intersecting_pairs", Uint32Array::from(&flat[..]).into())?;

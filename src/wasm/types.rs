@@ -133,6 +133,10 @@ export interface MeshStats {
   /** Faces at a sharp edge (true normals at their corners over 30° apart), and their normal
    * deviation p95: where "crinkly" edges show. */
   crease_faces: number | null; crease_normal_dev_deg_p95: number | null;
+  /** Per face against the nearest true normal at its corners, centroid and the points between:
+   * a face lying flat beside a crease reads 0 (the centroid's gradient can be the other side's,
+   * which normal_dev_deg_* then count); spikes and faces turned over stay large. */
+  face_normal_dev_deg_p95: number | null; face_normal_dev_deg_max: number | null;
   /** Milliseconds of meshing (analysis excluded). */
   ms_total: number;
   /** Milliseconds per phase, in the order the phases ran. */

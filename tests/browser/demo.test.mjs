@@ -16,7 +16,7 @@ test('both viewports mesh the default scene, EMC and DMC, as closed manifolds wi
     assert.equal(await stat(page, side, 'closed manifold'), 'yes');
     // The cube minus a ball that pokes through all six faces is a frame of genus 5.
     assert.equal(await stat(page, side, 'Euler characteristic'), '-8');
-    for (const key of ['max distance', 'RMS distance', 'normal deviation p95 (°)', 'at sharp edges (°)', 'smallest angle (°)', 'meshing (ms)']) {
+    for (const key of ['max distance', 'RMS distance', 'normal deviation p95 (°)', 'at sharp edges (°)', 'worst face (°)', 'smallest angle (°)', 'meshing (ms)']) {
       assert.ok(Number.isFinite(await count(page, side, key)), `${side} ${key}`);
     }
     assert.ok(await page.$eval(`${side} .histogram`, (c) => Number(c.dataset.bins)) > 3, 'angle histogram drawn');

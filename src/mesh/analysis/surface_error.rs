@@ -32,6 +32,14 @@ pub struct SurfaceError {
     pub crease_faces: usize,
     /// The 95th percentile of the normal deviation over the crease faces alone, by area.
     pub crease_normal_dev_deg_p95: f64,
+    /// Per face, the angle to the *nearest* of the true normals at the projections of its
+    /// corners, its centroid and the points halfway between the two; the 95th percentile and the
+    /// maximum over the faces. A face lying flat against one side of a crease, whose centroid's
+    /// projection can land on the other side (and then reads as the whole dihedral angle in
+    /// `normal_dev_deg_*`), reads near 0 here; a face cutting across a crease reads about half
+    /// its dihedral angle, a spike or a face turned over stays large. Slivers count as they are.
+    pub face_normal_dev_deg_p95: f64,
+    pub face_normal_dev_deg_max: f64,
     /// Distance samples taken: every referenced vertex plus four points per triangle.
     pub samples: usize,
     /// Samples whose projection did not settle (vanishing gradient, or still moving after the last
@@ -125,6 +133,7 @@ fn measure<E>(
     let crease_cos = CREASE_DEG.to_radians().cos();
     let mut deviations = Vec::with_capacity(faces.len());
     let mut crease_deviations = Vec::new();
+    let mut face_deviations = Vec::with_capacity(faces.len());
     for (i, &[a, b, c]) in faces.iter().enumerate() {
         if i % FACES_PER_TICK == 0 {
             tick(i as f32 / faces.len() as f32)?;
@@ -133,16 +142,24 @@ fn measure<E>(
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
         let on_surface = projector.project(centroid);
         record(&on_surface);
-        for corner in corners {
-            record(&projector.project((centroid + corner) * 0.5));
-        }
+        let halfway = corners.map(|corner| projector.project((centroid + corner) * 0.5));
+        halfway.iter().for_each(&mut record);
         let twice_area = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
         let normal = twice_area.normalize_or_zero();
         let gradient = projector.gradient(on_surface.point).normalize_or_zero();
+        let angle_to = |g: DVec3| normal.cross(g).length().atan2(normal.dot(g)).to_degrees();
         if normal != DVec3::ZERO && gradient != DVec3::ZERO {
-            let angle = normal.cross(gradient).length().atan2(normal.dot(gradient)).to_degrees();
+            let angle = angle_to(gradient);
             deviations.push(angle);
             let n = [a, b, c].map(|v| corner_normals[v as usize]);
+            let nearest = halfway
+                .iter()
+                .map(|h| projector.gradient(h.point).normalize_or_zero())
+                .chain(n)
+                .filter(|&g| g != DVec3::ZERO)
+                .map(angle_to)
+                .fold(angle, f64::min);
+            face_deviations.push(nearest);
             let at_crease = [(0, 1), (1, 2), (2, 0)]
                 .iter()
                 .any(|&(i, j)| n[i] != DVec3::ZERO && n[j] != DVec3::ZERO && n[i].dot(n[j]) < crease_cos);
@@ -156,6 +173,9 @@ fn measure<E>(
     result.normal_dev_deg_p50 = nearest_rank(&deviations, 0.50);
     result.normal_dev_deg_p95 = nearest_rank(&deviations, 0.95);
     result.normal_dev_deg_max = deviations.last().copied().unwrap_or(0.0);
+    face_deviations.sort_unstable_by(f64::total_cmp);
+    result.face_normal_dev_deg_p95 = nearest_rank(&face_deviations, 0.95);
+    result.face_normal_dev_deg_max = face_deviations.last().copied().unwrap_or(0.0);
     crease_deviations.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     result.crease_faces = crease_deviations.len();
     result.crease_normal_dev_deg_p95 = area_weighted_rank(&crease_deviations, 0.95);
@@ -352,6 +372,31 @@ mod tests {
         assert!(emc.crease_normal_dev_deg_p95 < 1.0, "{emc:?}");
     }
 
+    /// A face lying in a box's top plane a little inside the solid, along an edge: its centroid
+    /// is nearer the side face, so the centroid's gradient is the side's (90° off), while its far
+    /// corner's nearest face is the top, the face's own plane. Turned over, it is off every
+    /// normal near it.
+    #[test]
+    fn a_face_flat_beside_a_crease_is_right_by_the_nearest_normal() {
+        let field = crate::expr::compile("box(0.5, 0.5, 0.5)").unwrap();
+        let z = 0.4999;
+        let mut mesh = Mesh {
+            positions: vec![
+                Vec3::new(0.499998, -0.1, z),
+                Vec3::new(0.499998, 0.1, z),
+                Vec3::new(0.49985, 0.0, z),
+            ],
+            normals: Vec::new(),
+            triangles: vec![[0, 1, 2]],
+        };
+        let e = surface_error(&mesh, &field);
+        assert!((e.normal_dev_deg_max - 90.0).abs() < 1e-3, "{e:?}");
+        assert!(e.face_normal_dev_deg_max < 1e-3, "{e:?}");
+        mesh.triangles[0].swap(1, 2);
+        let e = surface_error(&mesh, &field);
+        assert!(e.face_normal_dev_deg_max > 90.0 - 1e-3, "{e:?}");
+    }
+
     #[test]
     fn weighted_ranks_count_area_not_faces() {
         let slivers_and_one_face = [(1.0, 10.0), (80.0, 1e-6), (90.0, 1e-6)];
@@ -369,6 +414,8 @@ mod tests {
         }
         let e = surface_error(&m, &sphere);
         assert!((e.normal_dev_deg_max - 180.0).abs() < 1e-3);
+        // Against the nearest normal, its corners' (54.7° from the face's on this coarse mesh).
+        assert!((e.face_normal_dev_deg_max - 125.26).abs() < 0.01, "{e:?}");
         assert!(e.normal_dev_deg_p50 < 1e-3, "half the faces are still right");
     }
 
