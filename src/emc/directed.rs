@@ -16,7 +16,7 @@ use super::edges::{EdgeSampler, FieldRoots};
 use super::mesh_source::{check_encloses, grid_values, MeshBvh, MeshRays};
 use super::{mesh_with_sampler, EmcMesh, EmcOptions, EmcTimings};
 use crate::error::Error;
-use crate::field::{sample_level, Field};
+use crate::field::{sample_level_probed, Field};
 use crate::grid::Grid;
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -67,7 +67,7 @@ impl DirectedGrid {
     /// Samples a field: sides from its values, crossings by root finding along the edges, normals
     /// from its gradient.
     pub fn from_field(field: &dyn Field, grid: &Grid, iso: f32) -> Result<DirectedGrid, Error> {
-        let (values, _) = sample_level(field, grid, iso, false)?;
+        let (values, _) = sample_level_probed(field, grid, iso, false)?;
         let sampler = FieldRoots { field, iso, directed: true, h: grid.cell_size() };
         DirectedGrid::sample(&values, grid, iso, &sampler)
     }

@@ -31,7 +31,7 @@ pub mod untangle;
 pub mod winding;
 
 use crate::error::Error;
-use crate::field::{check_finite, sample_level, Field};
+use crate::field::{check_finite, sample_level_probed, Field};
 use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::mc::{ms_since, CellTables, EdgeCache, Topology, NONE};
 use crate::mcq::PolygonRules;
@@ -169,7 +169,7 @@ pub fn mesh_field(
     options.validate()?;
     grid.check_size(options.max_cells)?;
     let t0 = Instant::now();
-    let (values, evaluated) = sample_level(field, grid, options.iso, options.crust)?;
+    let (values, evaluated) = sample_level_probed(field, grid, options.iso, options.crust)?;
     let sample_ms = ms_since(t0);
     let sampler = FieldRoots { field, iso: options.iso, directed: options.directed, h: grid.cell_size() };
     let (mut mesh, mut timings) = mesh_with_sampler(&values, grid, options, &sampler)?;
