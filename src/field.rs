@@ -396,12 +396,12 @@ pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32) {
 
 /// [`snap_to_level`], and where no grid line through a sample has inside points on both sides
 /// nor air on both, the function itself asked a thousandth of a cell to either side of it along
-/// each axis: inside where some axis has it inside on both sides and none outside on both. The grid's neighbours are a
-/// cell away, and within a cell a part can narrow: where a cone stands on a cylinder's top
-/// (the rocket's nose on its body, their shared disc in a grid plane), the disc's points near its
-/// rim have the cylinder below and air above, a cell up, yet the cone just above them; outside,
-/// they made a slit between body and nose at the rim, and EMC fanned a face across it turned
-/// over (the rocket at 80 cells, 178° off). A box's face on a grid plane still has air on one
+/// each axis: inside where some axis has it inside on both sides and none outside on both. The
+/// grid's neighbours are a cell away, and within a cell a part can narrow: where a cone stands
+/// on a cylinder's top (the rocket's nose on its body, their shared disc in a grid plane), the
+/// disc's points near its rim have the cylinder below and air above, a cell up, yet the cone
+/// just above them; outside, they made a slit between body and nose at the rim, and EMC fanned
+/// a face across it turned over (the rocket at 80 cells, 178° off). A box's face on a grid plane still has air on one
 /// side. Two balls touching at a grid point keep the grid's air on both sides across the line
 /// joining them, which probes so near would not see (the balls are a millionth apart there).
 pub fn snap_to_level_probing(values: &mut [f32], grid: &Grid, iso: f32, probe: Option<&dyn Field>) {

@@ -302,8 +302,9 @@ type PointBox = ([i64; 3], [i64; 3]);
 /// no grid line through it has air at both its neighbours, and one has the inside of a box at
 /// both, or, for EMC's samples (`sample_level_probed`: the function asked a thousandth of a cell
 /// away), one has the inside of boxes just beside it on both sides and none air on both (a face
-/// shared with a box one cell thick); otherwise exactly on the level (outside). Rounding made such unions' faces step between grid
-/// planes in teeth (`tests/emc_quality.rs`) and split parts sharing a face along it.
+/// shared with a box one cell thick); otherwise exactly on the level (outside). Rounding made
+/// such unions' faces step between grid planes in teeth (`tests/emc_quality.rs`) and split parts
+/// sharing a face along it.
 #[test]
 fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
     for seed in common::case_seeds(19_000, 24) {
