@@ -341,7 +341,7 @@ pub fn sample_level(
 }
 
 /// [`sample_level`] with the samples the grid leaves undecided on the level given their side by
-/// the function itself ([`snap_to_level_probing`]): for meshers that read only the samples' signs
+/// the function itself ([`snap_to_level`]): for meshers that read only the samples' signs
 /// and find crossings on the function (EMC). Not for interpolating ones: a sample on a face two
 /// parts share keeps the value 0 however deep inside the union it lies, so Marching Cubes puts
 /// the surface through it either way, and with it inside made more faces turn over where a cone
@@ -367,7 +367,7 @@ fn sample_level_with(
         Some(c) => (c.values, c.evaluated),
         None => (sample_grid(field, grid)?, grid.point_count()),
     };
-    snap_to_level_probing(&mut values, grid, iso, probe.then_some(field));
+    snap_to_level(&mut values, grid, iso, probe.then_some(field));
     Ok((values, evaluated))
 }
 
@@ -390,21 +390,18 @@ fn sample_level_with(
 /// point stays outside, the parts apart, as before. Samples given as data are the caller's and
 /// are not changed. The surface moves by at most the tolerance (crossings keep a thousandth of an
 /// edge off their ends anyway: [`crate::mc::MIN_EDGE_FRACTION`]).
-pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32) {
-    snap_to_level_probing(values, grid, iso, None)
-}
-
-/// [`snap_to_level`], and where no grid line through a sample has inside points on both sides
-/// nor air on both, the function itself asked a thousandth of a cell to either side of it along
-/// each axis: inside where some axis has it inside on both sides and none outside on both. The
-/// grid's neighbours are a cell away, and within a cell a part can narrow: where a cone stands
-/// on a cylinder's top (the rocket's nose on its body, their shared disc in a grid plane), the
-/// disc's points near its rim have the cylinder below and air above, a cell up, yet the cone
-/// just above them; outside, they made a slit between body and nose at the rim, and EMC fanned
-/// a face across it turned over (the rocket at 80 cells, 178° off). A box's face on a grid plane still has air on one
-/// side. Two balls touching at a grid point keep the grid's air on both sides across the line
-/// joining them, which probes so near would not see (the balls are a millionth apart there).
-pub fn snap_to_level_probing(values: &mut [f32], grid: &Grid, iso: f32, probe: Option<&dyn Field>) {
+///
+/// With `probe`, a sample that no grid line decides (no inside samples at both neighbours, no air
+/// at both) is asked of the function itself a thousandth of a cell to either side along each
+/// axis: inside where some axis has it inside on both sides and none outside on both. The grid's
+/// neighbours are a cell away, and within a cell a part can narrow: where a cone stands on a
+/// cylinder's top (the rocket's nose on its body, their shared disc in a grid plane), the disc's
+/// points near its rim have the cylinder below and air above, a cell up, yet the cone just above
+/// them; outside, they made a slit between body and nose at the rim, and EMC fanned a face across
+/// it turned over (the rocket at 80 cells, 178° off). A box's face on a grid plane still has air
+/// on one side. Two balls touching at a grid point keep the grid's air on both sides across the
+/// line joining them, which probes so near would not see (the balls are a millionth apart there).
+pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32, probe: Option<&dyn Field>) {
     let within = level_tolerance(grid, iso);
     // Few samples lie on the level: runs of them are ruled out in one vectorised pass each (a
     // branch per sample cost a fifth of a sphere's sampling at 256 cells).
@@ -490,7 +487,7 @@ fn probed_sides(field: &dyn Field, grid: &Grid, iso: f32, within: f32, asked: &[
 /// Probe values per batch of [`probed_sides`].
 const PROBE_BATCH: usize = 4096;
 
-/// How far to either side of a sample on the level [`snap_to_level_probing`] asks the function,
+/// How far to either side of a sample on the level [`snap_to_level`] asks the function,
 /// in cells: far enough that evaluation error cannot give the probes a side (crossings stay a
 /// thousandth of an edge off the grid points anyway), near enough that no part narrows away.
 const PROBE_CELLS: f32 = 1e-3;

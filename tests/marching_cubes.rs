@@ -353,10 +353,14 @@ fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
         let text = parts.iter().skip(1).fold(parts[0].clone(), |acc, p| format!("union({acc}, {p})"));
         let field = isoforge::expr::compile(&text).unwrap();
         let grid = Grid::with_resolution(Vec3::splat(-1.0), Vec3::splat(1.0), res as usize).unwrap();
-        let strictly =
-            |g: [i64; 3]| boxes.iter().any(|(lo, hi)| (0..3).all(|a| lo[a] < g[a] && g[a] < hi[a]));
-        let closed =
-            |g: [i64; 3]| boxes.iter().any(|(lo, hi)| (0..3).all(|a| lo[a] <= g[a] && g[a] <= hi[a]));
+        // Points of the continuous lattice (grid points and points just beside them) in the
+        // boxes' interiors, and in the closed boxes.
+        let strictly = |q: [f64; 3]| {
+            boxes.iter().any(|(lo, hi)| (0..3).all(|a| (lo[a] as f64) < q[a] && q[a] < hi[a] as f64))
+        };
+        let closed = |q: [f64; 3]| {
+            boxes.iter().any(|(lo, hi)| (0..3).all(|a| (lo[a] as f64) <= q[a] && q[a] <= hi[a] as f64))
+        };
         for (crust, probed) in [(true, false), (false, false), (true, true), (false, true)] {
             let sample = if probed { sample_level_probed } else { sample_level };
             let (values, _) = sample(&field, &grid, 0.0, crust).unwrap();
@@ -367,42 +371,29 @@ fn samples_on_the_level_take_their_side_by_rule_not_by_rounding() {
                 let what = || {
                     format!("seed {seed}: {text} at {res}, point {g:?}, crust {crust}, probed {probed}: {v}")
                 };
-                if strictly(g) {
+                let at = g.map(|c| c as f64);
+                if strictly(at) {
                     assert!(v < 0.0, "{}: inside", what());
-                } else if !closed(g) {
+                } else if !closed(at) {
                     assert!(v > 0.0, "{}: outside", what());
                 } else {
                     on_faces += 1;
-                    let step = |a: usize, s: i64| {
-                        let mut q = g;
-                        q[a] += s;
+                    // `d` along axis `a` from the point, in cells: its grid neighbours at 1, the
+                    // function's probes at a thousandth.
+                    let step = |a: usize, d: f64| {
+                        let mut q = at;
+                        q[a] += d;
                         q
                     };
-                    let inner =
-                        |a: usize| g[a] > 0 && g[a] < res && strictly(step(a, -1)) && strictly(step(a, 1));
-                    let air =
-                        |a: usize| g[a] > 0 && g[a] < res && !closed(step(a, -1)) && !closed(step(a, 1));
-                    // Just beside the point along axis `a`, in lattice units (boxes are open or
-                    // closed sets of the continuous lattice).
-                    let beside = |a: usize, s: f64| {
-                        let mut q = g.map(|c| c as f64);
-                        q[a] += s * 1e-3;
-                        q
+                    let both = |a: usize, d: f64, test: &dyn Fn([f64; 3]) -> bool| {
+                        test(step(a, -d)) && test(step(a, d))
                     };
-                    let in_open = |q: [f64; 3]| {
-                        boxes
-                            .iter()
-                            .any(|(lo, hi)| (0..3).all(|b| (lo[b] as f64) < q[b] && q[b] < hi[b] as f64))
-                    };
-                    let in_closed = |q: [f64; 3]| {
-                        boxes
-                            .iter()
-                            .any(|(lo, hi)| (0..3).all(|b| (lo[b] as f64) <= q[b] && q[b] <= hi[b] as f64))
-                    };
-                    let near_inner = |a: usize| in_open(beside(a, -1.0)) && in_open(beside(a, 1.0));
-                    let near_air = |a: usize| !in_closed(beside(a, -1.0)) && !in_closed(beside(a, 1.0));
+                    let inside_grid = |a: usize| g[a] > 0 && g[a] < res && both(a, 1.0, &strictly);
+                    let air = |a: usize| g[a] > 0 && g[a] < res && both(a, 1.0, &|q| !closed(q));
+                    let near_inner = |a: usize| both(a, 1e-3, &strictly);
+                    let near_air = |a: usize| both(a, 1e-3, &|q| !closed(q));
                     let beside_inside = probed && (0..3).any(near_inner) && !(0..3).any(near_air);
-                    if ((0..3).any(inner) || beside_inside) && !(0..3).any(air) {
+                    if ((0..3).any(inside_grid) || beside_inside) && !(0..3).any(air) {
                         assert!(v < 0.0, "{}: between two parts", what());
                     } else {
                         assert_eq!(v, 0.0, "{}: on the surface", what());
