@@ -183,6 +183,9 @@ struct Work<'a> {
     /// Per face, its estimated distance from the surface once measured.
     distance: Vec<f32>,
     triangles: Vec<[u32; 3]>,
+    /// Per face, [`Work::shape`] of its triangle as it stands: every change weighs the faces it
+    /// replaces, and a bad face's neighbours are weighed again for each of its nine changes.
+    shapes: Vec<Shape>,
     alive: Vec<bool>,
     faces_of: Vec<Vec<u32>>,
     fixed: Vec<bool>,
@@ -217,12 +220,6 @@ impl Work<'_> {
         crate::mesh::buckets::bounds(&self.corners(self.triangles[f as usize]))
     }
 
-    /// Live triangles whose boxes meet `c`'s.
-    fn near(&mut self, c: &Corners, out: &mut Vec<u32>) {
-        let (lo, hi) = crate::mesh::buckets::bounds(c);
-        self.nearby.query(lo, hi, out);
-    }
-
     /// Whether `change` is an improvement that keeps the surface where it was, and how good: it
     /// leaves fewer bad triangles, or as many with a larger worst angle, and turns no new triangle
     /// from the surface by more than [`MAX_TURN_DEG`] (or than the worst it replaces). Returns
@@ -234,7 +231,7 @@ impl Work<'_> {
             if t == Some(old) {
                 continue;
             }
-            before.add(self.shape(old));
+            before.add(self.shapes[f as usize]);
             if let Some(t) = t {
                 after.add(self.shape(t));
             }
@@ -257,18 +254,32 @@ impl Work<'_> {
         clear
     }
 
-    /// [`Work::clear`] with a buffer for the triangles nearby.
+    /// [`Work::clear`] with a buffer for the triangles nearby. One look-up over the box of all the
+    /// new triangles: a collapse makes four to six of them around one vertex, which share most of
+    /// their neighbourhood, and a look-up per triangle was most of this check's cost.
     fn clear_with(&mut self, change: &[(u32, Option<[u32; 3]>)], candidates: &mut Vec<u32>) -> bool {
-        for &(f, t) in change {
-            let Some(t) = t else { continue };
-            if t == self.triangles[f as usize] {
-                continue;
-            }
-            let c = self.corners(t);
-            candidates.clear();
-            self.near(&c, candidates);
-            candidates.retain(|&g| !change.iter().any(|&(f, _)| f == g));
-            let nearby = candidates.iter().map(|&g| self.triangles[g as usize]);
+        let new: Vec<([u32; 3], Corners)> = change
+            .iter()
+            .filter_map(|&(f, t)| t.filter(|&t| t != self.triangles[f as usize]))
+            .map(|t| (t, self.corners(t)))
+            .collect();
+        let Some((lo, hi)) = new
+            .iter()
+            .map(|(_, c)| crate::mesh::buckets::bounds(c))
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        else {
+            return true;
+        };
+        candidates.clear();
+        self.nearby.query(lo, hi, candidates);
+        candidates.retain(|&g| !change.iter().any(|&(f, _)| f == g));
+        for &(t, c) in &new {
+            // Triangles whose boxes miss this one's can neither cross it nor share an edge with it.
+            let (tlo, thi) = crate::mesh::buckets::bounds(&c);
+            let nearby = candidates.iter().map(|&g| self.triangles[g as usize]).filter(|&u| {
+                let (ulo, uhi) = crate::mesh::buckets::bounds(&self.corners(u));
+                ulo.cmple(thi).all() && uhi.cmpge(tlo).all()
+            });
             let others = nearby.chain(change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t));
             for u in others {
                 let d = self.corners(u);
@@ -453,6 +464,7 @@ impl Work<'_> {
                 }
                 Some(t) => {
                     self.triangles[f as usize] = t;
+                    self.shapes[f as usize] = self.shape(t);
                     for v in t {
                         self.faces_of[v as usize].push(f);
                     }
@@ -467,7 +479,7 @@ impl Work<'_> {
         let mut out: Vec<(f64, u32)> = (0..self.triangles.len() as u32)
             .filter(|&f| self.alive[f as usize])
             .filter_map(|f| {
-                let s = self.shape(self.triangles[f as usize]);
+                let s = self.shapes[f as usize];
                 // Worst first: spikes by their turn, then slivers and specks by their angle.
                 s.bad.then_some((s.angle - s.deviation, f))
             })
@@ -547,6 +559,7 @@ pub fn improve(
         short: SHORT_EDGE * h as f64,
         distance: vec![f32::NAN; mesh.triangles.len()],
         triangles: mesh.triangles.clone(),
+        shapes: Vec::new(),
         alive: vec![true; mesh.triangles.len()],
         faces_of,
         fixed,
@@ -559,6 +572,7 @@ pub fn improve(
         candidates: Vec::new(),
         log: Vec::new(),
     };
+    work.shapes = work.triangles.iter().map(|&t| work.shape(t)).collect();
     let mut bad = work.bad_faces();
     let mut out = Improved { bad_before: bad.len(), ..Improved::default() };
     out.replayed = replay::replay(&mut work, history, near_cube(h));
@@ -569,7 +583,7 @@ pub fn improve(
         }
         let mut changed = 0;
         for &(_, f) in &bad {
-            if !work.alive[f as usize] || !work.shape(work.triangles[f as usize]).bad {
+            if !work.alive[f as usize] || !work.shapes[f as usize].bad {
                 continue;
             }
             let t = work.triangles[f as usize];
