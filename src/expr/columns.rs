@@ -8,6 +8,7 @@ use super::eval::{unary_slope, Domain, Dual};
 use super::ops::{self, BinaryOp, UnaryOp};
 use super::tape::{Instr, Tape};
 use glam::Vec3;
+use std::cell::RefCell;
 
 /// Points per column: enough to amortise dispatch, few enough that slots × lanes stays in cache.
 pub const LANES: usize = 64;
@@ -31,25 +32,63 @@ pub fn eval_columns(tape: &Tape, points: &[Vec3], out: &mut [f32]) {
         }
         return;
     }
-    run_columns(
-        tape,
-        points,
-        out,
-        |c| [c; LANES],
-        |col, axis, chunk| col.iter_mut().zip(chunk).for_each(|(c, p)| *c = p[axis]),
-        run_column,
-        |col, out| out.copy_from_slice(&col[..out.len()]),
-    );
+    with_columns(&VALUE_COLUMNS, tape.slot_count, |cols| {
+        run_columns(
+            tape,
+            points,
+            out,
+            cols,
+            |c| [c; LANES],
+            |col, axis, chunk| col.iter_mut().zip(chunk).for_each(|(c, p)| *c = p[axis]),
+            run_column,
+            |col, out| out.copy_from_slice(&col[..out.len()]),
+        )
+    });
 }
 
-/// Runs `tape` over `points`, 64 at a time, in columns of type `C`: constants filled by
-/// `constant`, the inputs' columns by `input(column, axis, chunk)`, each instruction run over its
-/// columns by `step`, and the output column's first lanes written by `result` (the first
-/// `min(points.len(), out.len())` entries of `out` in all).
+thread_local! {
+    /// Each thread's columns, kept from batch to batch (see [`with_columns`]).
+    static VALUE_COLUMNS: RefCell<Vec<Column>> = const { RefCell::new(Vec::new()) };
+    static DUAL_COLUMNS: RefCell<Vec<DualColumn>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Tapes with more slots than this get columns of their own for each batch rather than growing
+/// the thread's kept ones (4 MB of dual columns): a user's program can be that long, the
+/// meshers' brick tapes are a few dozen slots.
+const KEPT_SLOTS: usize = 4096;
+
+/// Calls `f` with the thread's kept columns of `cache`. A column per slot is 256 bytes (1 KB for
+/// duals), and allocating and zeroing them for every batch was most of a small batch's setup:
+/// DMC's tests on the gear at 128 cells spent 3 % of their instructions in that `memset`. No slot
+/// is read before it is written in a batch (constants and inputs are filled first, every
+/// instruction writes its output before a later one reads it), so what a column held before does
+/// not matter.
+fn with_columns<C, R>(
+    cache: &'static std::thread::LocalKey<RefCell<Vec<C>>>,
+    slots: usize,
+    f: impl FnOnce(&mut Vec<C>) -> R,
+) -> R {
+    if slots > KEPT_SLOTS {
+        return f(&mut Vec::new());
+    }
+    cache.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut kept) => f(&mut kept),
+        // A batch inside a batch on this thread (none today): columns of its own.
+        Err(_) => f(&mut Vec::new()),
+    })
+}
+
+/// Runs `tape` over `points`, 64 at a time, in columns of type `C` (`cols`: at least one per
+/// slot once grown, their contents unread): constants filled by `constant`, the inputs' columns
+/// by `input(column, axis, chunk)`, each instruction run over its columns by `step`, and the
+/// output column's first lanes written by `result` (the first `min(points.len(), out.len())`
+/// entries of `out` in all).
+#[allow(clippy::too_many_arguments)]
 fn run_columns<C: Clone, O>(
     tape: &Tape,
     points: &[Vec3],
     out: &mut [O],
+    cols: &mut Vec<C>,
     constant: impl Fn(f32) -> C,
     input: impl Fn(&mut C, usize, &[Vec3]),
     step: impl Fn(&Instr, &mut [C]),
@@ -59,7 +98,10 @@ fn run_columns<C: Clone, O>(
     if n == 0 {
         return;
     }
-    let mut cols: Vec<C> = vec![constant(0.0); tape.slot_count];
+    if cols.len() < tape.slot_count {
+        cols.resize(tape.slot_count, constant(0.0));
+    }
+    let cols = &mut cols[..tape.slot_count];
     for (col, &c) in cols.iter_mut().zip(&tape.consts) {
         *col = constant(c);
     }
@@ -71,7 +113,7 @@ fn run_columns<C: Clone, O>(
             }
         }
         for instr in &tape.instrs {
-            step(instr, &mut cols);
+            step(instr, cols);
         }
         result(&cols[tape.output as usize], &mut out[start..start + chunk.len()]);
     }
@@ -159,24 +201,27 @@ pub fn eval_gradient_columns<O>(tape: &Tape, points: &[Vec3], out: &mut [O], wra
         }
         return;
     }
-    run_columns(
-        tape,
-        points,
-        out,
-        DualColumn::constant,
-        |col, axis, chunk| {
-            for (l, p) in chunk.iter().enumerate() {
-                col.set_lane(l, Dual::input(p[axis], axis));
-            }
-        },
-        run_dual_column,
-        |col, out| {
-            for (l, o) in out.iter_mut().enumerate() {
-                let lane = col.lane(l);
-                *o = wrap(lane.v, lane.d.into());
-            }
-        },
-    );
+    with_columns(&DUAL_COLUMNS, tape.slot_count, |cols| {
+        run_columns(
+            tape,
+            points,
+            out,
+            cols,
+            DualColumn::constant,
+            |col, axis, chunk| {
+                for (l, p) in chunk.iter().enumerate() {
+                    col.set_lane(l, Dual::input(p[axis], axis));
+                }
+            },
+            run_dual_column,
+            |col, out| {
+                for (l, o) in out.iter_mut().enumerate() {
+                    let lane = col.lane(l);
+                    *o = wrap(lane.v, lane.d.into());
+                }
+            },
+        )
+    });
 }
 
 /// One instruction over a column of duals, component by component, with the very formulas of
