@@ -361,4 +361,36 @@ mod tests {
             }
         }
     }
+
+    /// The thread keeps its columns from batch to batch: whatever a longer program left in them
+    /// (NaN and infinities included) must not reach a later program's results. Programs of every
+    /// length take turns on one thread, each batch after a poisoning one, in shuffled order.
+    #[test]
+    fn kept_columns_carry_nothing_from_one_batch_to_the_next() {
+        let poison = compile("sqrt(x - 2) / (y * 0) + log(z - 5)").unwrap();
+        let mut programs: Vec<_> = CASES.iter().map(|case| (case, compile(case).unwrap())).collect();
+        let mut rng = Rng::new(11);
+        for round in 0..3 {
+            for i in (1..programs.len()).rev() {
+                programs.swap(i, rng.below(i + 1));
+            }
+            for (case, program) in &programs {
+                let points = points(13 + round);
+                let mut scratch = vec![0.0; points.len()];
+                poison.eval_many(&points, &mut scratch);
+                let mut scratch_dual = vec![Vec3::ZERO; points.len()];
+                poison.eval_grad_many(&points, &mut scratch_dual);
+                let mut values = vec![0.0; points.len()];
+                program.eval_many(&points, &mut values);
+                let mut both = vec![(0.0, Vec3::ZERO); points.len()];
+                program.eval_value_grad_many(&points, &mut both);
+                for ((p, &v), &(bv, bg)) in points.iter().zip(&values).zip(&both) {
+                    let (ev, eg) = program.eval_grad(*p);
+                    assert!(same(v, program.eval(*p)), "{case} at {p}: {v} after another batch");
+                    assert!(same(bv, ev), "{case} at {p}: {bv} vs {ev} after another batch");
+                    assert!((0..3).all(|i| same(eg[i], bg[i])), "{case} at {p}: {bg} vs {eg}");
+                }
+            }
+        }
+    }
 }
