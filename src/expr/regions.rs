@@ -291,9 +291,19 @@ impl<'a> RegionalProgram<'a> {
             }
         }
         let order: Vec<usize> = if distinct.len() > 32 {
-            let mut order: Vec<usize> = (0..n).collect();
-            order.sort_unstable_by_key(|&i| keys[i]);
-            order
+            // Key and index packed into one word (keys are brick numbers, far under 2³², and
+            // `usize::MAX` for outside becomes `u32::MAX`): a plain integer sort. Sorting the
+            // indices by a look-up of their keys was 3 % of DMC's instructions on the gear.
+            if n > u32::MAX as usize {
+                let mut order: Vec<usize> = (0..n).collect();
+                order.sort_unstable_by_key(|&i| keys[i]);
+                order
+            } else {
+                let mut packed: Vec<u64> =
+                    keys.iter().enumerate().map(|(i, &k)| ((k as u32 as u64) << 32) | i as u64).collect();
+                packed.sort_unstable();
+                packed.into_iter().map(|w| (w & u64::from(u32::MAX)) as usize).collect()
+            }
         } else {
             // A counting sort over the distinct keys' positions.
             let group: Vec<usize> =
