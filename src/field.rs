@@ -417,24 +417,17 @@ pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32, probe: Option<&d
     })
     .concat();
     let [nx, ny, nz] = grid.points();
-    // Per axis through the point: both neighbours inside, both clearly outside.
+    // Per axis through the point, its two neighbours' values where it has both.
     let flanks = |n: usize| {
         let [i, j, k] = grid.unindex(n);
         [(i, nx, 1), (j, ny, nx), (k, nz, nx * ny)].map(|(at, count, step)| {
-            let ends = (at > 0 && at + 1 < count).then(|| [values[n - step] - iso, values[n + step] - iso]);
-            ends.map_or((false, false), |e| (e.iter().all(|&d| d < -within), e.iter().all(|&d| d > within)))
+            (at > 0 && at + 1 < count).then(|| [values[n - step] - iso, values[n + step] - iso])
         })
     };
     // Where the grid decides, its side; where it cannot and there is a function, `None`.
     let by_grid: Vec<Option<bool>> = crate::par::map(on_level.len(), |i| {
-        let axes = flanks(on_level[i]);
-        if axes.iter().any(|a| a.1) {
-            Some(false)
-        } else if axes.iter().any(|a| a.0) {
-            Some(true)
-        } else {
-            probe.is_none().then_some(false)
-        }
+        side_between(flanks(on_level[i]).into_iter().flatten(), within)
+            .or_else(|| probe.is_none().then_some(false))
     });
     let asked: Vec<usize> =
         on_level.iter().zip(&by_grid).filter(|(_, side)| side.is_none()).map(|(&n, _)| n).collect();
@@ -446,8 +439,8 @@ pub fn snap_to_level(values: &mut [f32], grid: &Grid, iso: f32, probe: Option<&d
     }
 }
 
-/// Per sample `n` of `asked`: whether `field` is inside on both sides of it, a [`PROBE_CELLS`]
-/// step away, along some axis, and outside on both along none. The six values per sample are
+/// Per sample `n` of `asked`: its side by [`side_between`] from `field`'s values a
+/// [`PROBE_CELLS`] step to either side along each axis (outside where none decides). The six values per sample are
 /// taken in batches on the threads: a box's faces on grid planes are all asked (400 000 points
 /// at 256 cells), and one value at a time cost a third of the sampling there.
 fn probed_sides(field: &dyn Field, grid: &Grid, iso: f32, within: f32, asked: &[usize]) -> Vec<bool> {
@@ -471,17 +464,28 @@ fn probed_sides(field: &dyn Field, grid: &Grid, iso: f32, within: f32, asked: &[
     probes
         .chunks_exact(6)
         .map(|ends| {
-            let axes = ends.chunks_exact(2).map(|e| (e[0] - iso, e[1] - iso));
-            let mut inside = false;
-            for (a, b) in axes {
-                if a > within && b > within {
-                    return false;
-                }
-                inside |= a < -within && b < -within;
-            }
-            inside
+            side_between(ends.chunks_exact(2).map(|e| [e[0] - iso, e[1] - iso]), within).unwrap_or(false)
         })
         .collect()
+}
+
+/// The side of a sample on the level from the values (minus the level) at both ends of lines
+/// through it: outside where both ends of some line are beyond `within` outside, else inside where
+/// both ends of some line are inside, `None` where no line decides. [`snap_to_level`]'s rule, for
+/// the grid's neighbours and for the function's probes alike.
+fn side_between(lines: impl IntoIterator<Item = [f32; 2]>, within: f32) -> Option<bool> {
+    let (mut inside, mut outside) = (false, false);
+    for ends in lines {
+        inside |= ends.iter().all(|&d| d < -within);
+        outside |= ends.iter().all(|&d| d > within);
+    }
+    if outside {
+        Some(false)
+    } else if inside {
+        Some(true)
+    } else {
+        None
+    }
 }
 
 /// Probe values per batch of [`probed_sides`].
