@@ -274,16 +274,24 @@ impl Work<'_> {
         candidates.clear();
         self.nearby.query(lo, hi, candidates);
         candidates.retain(|&g| !change.iter().any(|&(f, _)| f == g));
+        let nearby: Vec<([u32; 3], Corners, (glam::DVec3, glam::DVec3))> = candidates
+            .iter()
+            .map(|&g| {
+                let u = self.triangles[g as usize];
+                let d = self.corners(u);
+                (u, d, crate::mesh::buckets::bounds(&d))
+            })
+            .collect();
         for &(t, c) in &new {
             // Triangles whose boxes miss this one's can neither cross it nor share an edge with it.
             let (tlo, thi) = crate::mesh::buckets::bounds(&c);
-            let nearby = candidates.iter().map(|&g| self.triangles[g as usize]).filter(|&u| {
-                let (ulo, uhi) = crate::mesh::buckets::bounds(&self.corners(u));
-                ulo.cmple(thi).all() && uhi.cmpge(tlo).all()
-            });
-            let others = nearby.chain(change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t));
-            for u in others {
-                let d = self.corners(u);
+            let near = nearby
+                .iter()
+                .filter(|(_, _, (ulo, uhi))| ulo.cmple(thi).all() && uhi.cmpge(tlo).all())
+                .map(|&(u, d, _)| (u, d));
+            let in_change =
+                change.iter().filter_map(|&(_, u)| u).filter(|&u| u != t).map(|u| (u, self.corners(u)));
+            for (u, d) in near.chain(in_change) {
                 if crate::mesh::analysis::self_intersect::indexed_pair_intersects((t, c), (u, d)) {
                     return false;
                 }
